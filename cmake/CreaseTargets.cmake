@@ -1,0 +1,72 @@
+# Helpers that every folder uses to declare plugins and tests.
+
+find_package(doctest REQUIRED)
+find_package(Threads REQUIRED)
+
+# crease_plugin(NAME SOURCES... [LIBS ...])
+# A dlopen'able MODULE with hidden visibility, built with -fno-gnu-unique so dlclose
+# really unloads it. Output: ${CREASE_PLUGIN_DIR}/lib<NAME>.so
+function(crease_plugin name)
+  cmake_parse_arguments(P "" "" "SOURCES;LIBS" ${ARGN})
+  add_library(${name} MODULE ${P_SOURCES})
+  target_link_libraries(${name} PRIVATE crease_core crease_options ${P_LIBS})
+  set_target_properties(${name} PROPERTIES
+    CXX_VISIBILITY_PRESET hidden
+    VISIBILITY_INLINES_HIDDEN ON
+    LIBRARY_OUTPUT_DIRECTORY ${CREASE_PLUGIN_DIR})
+  target_compile_options(${name} PRIVATE -fno-gnu-unique)
+  target_link_options(${name} PRIVATE -Wl,--no-undefined)
+  set_property(GLOBAL APPEND PROPERTY CREASE_ALL_PLUGINS ${name})
+endfunction()
+
+# crease_test(NAME SOURCES... [LIBS ...] [LABELS ...] [DEPENDS targets] [TIMEOUT s])
+# One doctest executable registered with ctest. NAME mirrors the source path
+# (tests/rt/latest_test.cpp -> rt.latest). Labels: unit, hil, slow, concurrency.
+# The ASan build runs `unit`; the TSan build runs `concurrency`.
+function(crease_test name)
+  cmake_parse_arguments(T "" "TIMEOUT" "SOURCES;LIBS;LABELS;DEPENDS" ${ARGN})
+  string(REPLACE "." "_" exe "test_${name}")
+  add_executable(${exe} ${T_SOURCES})
+  target_link_libraries(${exe} PRIVATE crease_test_main crease_rt_alloc_hooks crease_options ${T_LIBS})
+  set_target_properties(${exe} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests ENABLE_EXPORTS ON)
+  target_compile_definitions(${exe} PRIVATE
+    CREASE_PLUGIN_DIR="${CREASE_PLUGIN_DIR}" CREASE_SOURCE_DIR="${CMAKE_SOURCE_DIR}"
+    CREASE_BIN_DIR="${CREASE_BIN_DIR}")
+  if(T_DEPENDS)
+    add_dependencies(${exe} ${T_DEPENDS})
+  endif()
+  add_test(NAME ${name} COMMAND ${exe})
+  if(NOT T_LABELS)
+    set(T_LABELS unit)
+  endif()
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 300)
+  endif()
+  set_tests_properties(${name} PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT})
+  foreach(label ${T_LABELS})
+    set_property(GLOBAL APPEND PROPERTY CREASE_TESTS_${label} ${exe})
+  endforeach()
+endfunction()
+
+# Targets `tests-unit`, `tests-concurrency`, ... build just the executables of one label,
+# so the sanitizer builds compile only what they run.
+function(crease_finish_test_targets)
+  foreach(label unit hil slow concurrency)
+    get_property(exes GLOBAL PROPERTY CREASE_TESTS_${label})
+    add_custom_target(tests-${label})
+    if(exes)
+      add_dependencies(tests-${label} ${exes})
+    endif()
+  endforeach()
+endfunction()
+
+# Adds every immediate subfolder of the current folder that has a CMakeLists.txt.
+function(crease_add_subdirs)
+  file(GLOB dirs LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/*)
+  list(SORT dirs)
+  foreach(dir ${dirs})
+    if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${dir} AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${dir}/CMakeLists.txt)
+      add_subdirectory(${dir})
+    endif()
+  endforeach()
+endfunction()

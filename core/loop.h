@@ -1,0 +1,108 @@
+// A loop: one periodic RT thread running an ordered schedule of plugin instances.
+//
+// The schedule is immutable while published. To change it (load, unload, hot-swap) the host
+// builds a new one off the RT thread and publishes it; at its next cycle boundary the loop
+// adopts it, carries state from replaced instances to their successors (save_state ->
+// load_state into a preallocated buffer) and acknowledges by publishing the schedule's
+// generation. Only then may the host free the old schedule and what it alone referenced
+// (ros2_control's RTControllerListWrapper pattern, with atomics and stated orders).
+//
+// The firewall: an update that returns fault, throws, returns an unknown code or writes a
+// non-finite output stops that instance (outputs driven safe, state faulted) and is reported
+// as an event; the loop keeps its timing and runs the others.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/plugin_instance.h"
+#include "rt/log_queue.h"
+#include "rt/periodic_loop.h"
+#include "rt/queue.h"
+
+namespace crease {
+
+struct LoopSpec {
+  std::string name;
+  double rate_hz = 1000.0;
+  int priority = 0;  // 0 = SCHED_OTHER, 1..99 = SCHED_FIFO
+  int cpu = -1;      // -1 = any
+};
+
+struct Schedule {
+  struct Entry {
+    PluginInstance* instance = nullptr;
+    PluginInstance* takes_state_from = nullptr;  // set for the new version in a hot-swap
+  };
+  std::vector<Entry> entries;  // in run order
+  std::uint64_t generation = 0;
+};
+
+// Reported by the loop thread, consumed by the host (non-RT).
+struct LoopEvent {
+  enum class Type : std::uint8_t { fault, swapped, deactivated, state_not_carried };
+  Type type = Type::fault;
+  FaultKind fault = FaultKind::none;
+  std::int32_t code = 0;
+  std::uint64_t cycle = 0;
+  std::int64_t time_ns = 0;
+  char instance[48] = {};  // instance name (copied: the instance may be gone when this is read)
+};
+
+class Loop {
+ public:
+  static constexpr std::size_t kStateBufferBytes = 64 * 1024;
+
+  explicit Loop(LoopSpec spec);
+  ~Loop();
+  Loop(const Loop&) = delete;
+  Loop& operator=(const Loop&) = delete;
+
+  // Non-RT.
+  std::vector<rt::SetupStep> start();
+  void stop();
+  [[nodiscard]] bool running() const noexcept { return thread_.running(); }
+
+  // Non-RT, one caller at a time. Publishes `next`. When the loop runs, waits (up to `timeout`)
+  // for the loop thread to adopt it; when it does not run, adopts it here. Returns the previous
+  // schedule once it is no longer used, or nullptr if the loop did not adopt in time (it
+  // will: call reclaim_adopted() later).
+  std::unique_ptr<Schedule> publish(std::unique_ptr<Schedule> next, std::chrono::milliseconds timeout);
+  // The schedule replaced by a late adoption, once adopted (else nullptr).
+  std::unique_ptr<Schedule> reclaim_adopted();
+  [[nodiscard]] const Schedule* schedule() const noexcept { return current_.load(std::memory_order_acquire); }
+
+  // Non-RT: events from the loop thread.
+  bool try_pop_event(LoopEvent& e) noexcept { return events_.try_pop(&e); }
+  [[nodiscard]] std::uint64_t events_dropped() const noexcept { return events_.dropped(); }
+
+  [[nodiscard]] const LoopSpec& spec() const noexcept { return spec_; }
+  [[nodiscard]] const rt::LoopTiming& timing() const noexcept { return thread_.timing(); }
+  [[nodiscard]] bool fifo_applied() const noexcept { return thread_.fifo_applied(); }
+  [[nodiscard]] rt::RtLogQueue& log_queue() noexcept { return log_; }
+  [[nodiscard]] std::int64_t period_ns() const noexcept { return thread_.settings().period_ns; }
+
+  // Runs one cycle on the calling thread (tests and benchmarks of the cycle itself).
+  void run_cycle_rt(const rt::CycleClock& clock) noexcept;
+
+ private:
+  static void body(void* self, const rt::CycleClock& clock) noexcept;
+  void adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept;
+  void push_event_rt(const LoopEvent& e) noexcept { (void)events_.try_push(&e); }
+
+  LoopSpec spec_;
+  std::atomic<Schedule*> current_{nullptr};   // owned; replaced only by adopt
+  std::atomic<Schedule*> pending_{nullptr};   // published by the host, taken by the loop
+  std::atomic<std::uint64_t> adopted_{0};     // generation of the last adopted schedule
+  Schedule* replaced_ = nullptr;              // old schedule awaiting reclaim after a late adoption
+  std::unique_ptr<unsigned char[]> state_buf_;
+  rt::QueueChannel events_;
+  rt::RtLogQueue log_;
+  rt::PeriodicLoop thread_;  // last: its thread stops before the members above go
+};
+
+}  // namespace crease

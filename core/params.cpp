@@ -1,0 +1,86 @@
+#include "core/params.h"
+
+namespace crease {
+namespace {
+std::string mark_text(const YAML::Node& n) {
+  if (!n) return "";
+  const YAML::Mark m = n.Mark();
+  if (m.line < 0) return "";
+  return std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ":";
+}
+}  // namespace
+
+Params::Params() : node_(YAML::NodeType::Map), used_(std::make_shared<std::set<std::string>>()) {}
+
+Params::Params(YAML::Node node, std::string file, std::string path)
+    : node_(node ? node : YAML::Node(YAML::NodeType::Map)),
+      file_(std::move(file)),
+      path_(std::move(path)),
+      used_(std::make_shared<std::set<std::string>>()) {
+  if (node_.IsNull()) node_ = YAML::Node(YAML::NodeType::Map);
+  if (!node_.IsMap()) fail({}, "expected a map of parameters");
+}
+
+bool Params::has(std::string_view key) const { return static_cast<bool>(node_[std::string(key)]); }
+
+std::string Params::where(std::string_view key) const {
+  YAML::Node n = key.empty() ? node_ : node_[std::string(key)];
+  std::string loc = file_.empty() ? std::string() : file_ + ":";
+  std::string m = mark_text(n ? n : node_);
+  if (!m.empty()) loc += m;
+  std::string p = path_;
+  if (!key.empty()) p += (p.empty() ? "" : ".") + std::string(key);
+  return loc.empty() ? p : loc + " " + p;
+}
+
+void Params::fail(std::string_view key, const std::string& reason) const {
+  throw ConfigError(where(key) + ": " + reason);
+}
+
+YAML::Node Params::lookup(std::string_view key, bool required) const {
+  const std::string k(key);
+  YAML::Node n = node_[k];
+  used_->insert(path_ + "." + k);
+  if (!n && required) fail(key, "required parameter is missing");
+  if (n && n.IsNull() && required) fail(key, "required parameter has no value");
+  if (n && n.IsNull()) return YAML::Node();
+  return n;
+}
+
+Params Params::child(std::string_view key) const {
+  const YAML::Node n = lookup(key, false);
+  used_->insert("child:" + path_ + "." + std::string(key));  // unused_keys() looks inside
+  if (!n) {
+    Params p(YAML::Node(YAML::NodeType::Map), file_, path_ + "." + std::string(key));
+    p.used_ = used_;
+    return p;
+  }
+  if (!n.IsMap()) fail(key, "expected a map");
+  Params p(n, file_, path_ + "." + std::string(key));
+  p.used_ = used_;
+  return p;
+}
+
+YAML::Node Params::raw(std::string_view key) const { return lookup(key, false); }
+
+std::vector<std::string> Params::unused_keys() const {
+  std::vector<std::string> out;
+  for (const auto& kv : node_) {
+    const std::string k = kv.first.as<std::string>();
+    const std::string full = path_ + "." + k;
+    if (!used_->count(full)) {
+      out.push_back(where(k));
+    } else if (kv.second.IsMap()) {
+      // A map opened with child(): its keys must be read too. (Maps read with raw() are the
+      // plugin's to check.)
+      if (used_->count("child:" + full)) {
+        Params c(kv.second, file_, full);
+        c.used_ = used_;
+        for (auto& s : c.unused_keys()) out.push_back(std::move(s));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace crease

@@ -1,0 +1,314 @@
+#include "core/plugin_host.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <thread>
+
+#include "core/errors.h"
+#include "rt/clock.h"
+
+namespace crease {
+
+const char* to_string(HostEvent::Type t) noexcept {
+  switch (t) {
+    case HostEvent::Type::loaded: return "loaded";
+    case HostEvent::Type::unloaded: return "unloaded";
+    case HostEvent::Type::swapped: return "swapped";
+    case HostEvent::Type::swap_state_lost: return "swapped (state not carried)";
+    case HostEvent::Type::fault: return "fault";
+    case HostEvent::Type::activated: return "activated";
+    case HostEvent::Type::deactivated: return "deactivated";
+  }
+  return "unknown";
+}
+
+PluginHost::PluginHost(std::vector<std::filesystem::path> plugin_dirs) : dirs_(std::move(plugin_dirs)) {}
+
+PluginHost::~PluginHost() {
+  stop();
+  std::lock_guard lock(mu_);
+  while (!managed_.empty()) managed_.pop_back();  // reverse order of loading
+  retired_.clear();
+}
+
+void PluginHost::set_event_sink(EventSink sink) {
+  std::lock_guard lock(mu_);
+  sink_ = std::move(sink);
+}
+
+void PluginHost::record(HostEvent e) {
+  if (e.time_ns == 0) e.time_ns = rt::now_ns();
+  if (e.type == HostEvent::Type::fault) ++faults_;
+  if (sink_) sink_(e);
+  events_.push_back(std::move(e));
+}
+
+PluginHost::Managed* PluginHost::find(const std::string& name) {
+  for (Managed& m : managed_) {
+    if (m.spec.name == name) return &m;
+  }
+  return nullptr;
+}
+
+const PluginHost::Managed* PluginHost::find(const std::string& name) const {
+  for (const Managed& m : managed_) {
+    if (m.spec.name == name) return &m;
+  }
+  return nullptr;
+}
+
+Loop* PluginHost::find_loop(const std::string& name) const {
+  for (const auto& l : loops_) {
+    if (l->spec().name == name) return l.get();
+  }
+  return nullptr;
+}
+
+Loop& PluginHost::add_loop(const LoopSpec& spec) {
+  std::lock_guard lock(mu_);
+  if (find_loop(spec.name) != nullptr) throw ConfigError("loop '" + spec.name + "' is defined twice");
+  if (!(spec.rate_hz > 0.0)) throw ConfigError("loop '" + spec.name + "': rate must be positive");
+  loops_.push_back(std::make_unique<Loop>(spec));
+  Loop& loop = *loops_.back();
+  if (running_) {
+    for (const rt::SetupStep& s : loop.start()) {
+      if (!s.applied) spdlog::warn("{} not applied: {}", s.what, s.why);
+    }
+  }
+  return loop;
+}
+
+bool PluginHost::reschedule(Loop& loop, PluginInstance* swap_to, PluginInstance* swap_from) {
+  std::vector<const Managed*> mine;
+  for (const Managed& m : managed_) {
+    if (m.loop == &loop) mine.push_back(&m);
+  }
+  std::stable_sort(mine.begin(), mine.end(), [](const Managed* a, const Managed* b) { return a->spec.order < b->spec.order; });
+  auto next = std::make_unique<Schedule>();
+  for (const Managed* m : mine) {
+    PluginInstance* inst = m->instance.get();
+    next->entries.push_back({inst, inst == swap_to ? swap_from : nullptr});
+  }
+  // When adoption is late, Loop keeps the old schedule until reclaim_adopted() hands it back.
+  return loop.publish(std::move(next), kAdoptTimeout) != nullptr;
+}
+
+void PluginHost::add_instance(const InstanceSpec& spec) {
+  std::lock_guard lock(mu_);
+  if (find(spec.name) != nullptr) throw ConfigError("instance '" + spec.name + "' is defined twice");
+  Loop* loop = find_loop(spec.loop);
+  if (loop == nullptr) throw ConfigError("instance '" + spec.name + "': no loop named '" + spec.loop + "'");
+  std::shared_ptr<PluginLibrary> lib = PluginLibrary::open(spec.library, dirs_);
+  std::unique_ptr<PluginInstance> inst;
+  try {
+    inst = std::make_unique<PluginInstance>(spec.name, lib, spec.params, spec.ports, ports_, &loop->log_queue(),
+                                            std::make_shared<PluginStats>());
+    if (spec.enabled) inst->activate();
+  } catch (...) {
+    inst.reset();
+    ports_.release(spec.name);
+    throw;
+  }
+  managed_.push_back(Managed{spec, std::move(inst), loop});
+  reschedule(*loop);
+  record({HostEvent::Type::loaded, spec.name, spec.loop,
+          lib->plugin_name() + " " + lib->plugin_version() + " from " + lib->path().string()});
+}
+
+std::vector<rt::SetupStep> PluginHost::start() {
+  std::lock_guard lock(mu_);
+  std::vector<rt::SetupStep> steps;
+  for (auto& l : loops_) {
+    for (rt::SetupStep& s : l->start()) steps.push_back(std::move(s));
+  }
+  running_ = true;
+  return steps;
+}
+
+bool PluginHost::running() const {
+  std::lock_guard lock(mu_);
+  return running_;
+}
+
+void PluginHost::stop() {
+  std::lock_guard lock(mu_);
+  for (auto& l : loops_) l->stop();
+  drain_locked();
+  const std::int64_t now = rt::now_ns();
+  for (auto it = managed_.rbegin(); it != managed_.rend(); ++it) {
+    PluginInstance& inst = *it->instance;
+    inst.drive_safe_outputs(now);
+    inst.state.store(RunState::inactive, std::memory_order_release);
+    inst.call_deactivate();
+  }
+  running_ = false;
+}
+
+void PluginHost::swap(const std::string& name, const std::string& library, const std::optional<Params>& params) {
+  std::lock_guard lock(mu_);
+  Managed* m = find(name);
+  if (m == nullptr) throw ConfigError("swap: no instance named '" + name + "'");
+  std::shared_ptr<PluginLibrary> lib = PluginLibrary::open(library, dirs_);
+  const Params& p = params ? *params : m->spec.params;
+  auto next = std::make_unique<PluginInstance>(name, lib, p, m->spec.ports, ports_, &m->loop->log_queue(),
+                                               m->instance->stats_ptr());
+  const RunState was = m->instance->state.load(std::memory_order_acquire);
+  if (was == RunState::active || was == RunState::faulted) next->activate();  // throws: old untouched
+
+  std::unique_ptr<PluginInstance> old = std::move(m->instance);
+  m->instance = std::move(next);
+  m->spec.library = library;
+  if (params) m->spec.params = *params;
+  if (reschedule(*m->loop, m->instance.get(), old.get())) {
+    old->call_deactivate();
+    old.reset();  // destroys the object, then dlcloses its library if nothing else holds it
+  } else {
+    retired_.push_back(std::move(old));  // not adopted yet: freed by poll() once it is
+  }
+  drain_locked();  // records the swap event with its cycle
+}
+
+void PluginHost::unload(const std::string& name) {
+  std::lock_guard lock(mu_);
+  auto it = std::find_if(managed_.begin(), managed_.end(), [&](const Managed& m) { return m.spec.name == name; });
+  if (it == managed_.end()) throw ConfigError("unload: no instance named '" + name + "'");
+  Loop* loop = it->loop;
+  std::unique_ptr<PluginInstance> inst = std::move(it->instance);
+  const std::string loop_name = it->spec.loop;
+  managed_.erase(it);
+  const bool adopted = reschedule(*loop);
+  if (adopted) {
+    inst->drive_safe_outputs(rt::now_ns());
+    inst->call_deactivate();
+    inst.reset();
+  } else {
+    retired_.push_back(std::move(inst));
+  }
+  ports_.release(name);
+  record({HostEvent::Type::unloaded, name, loop_name, {}});
+}
+
+void PluginHost::activate(const std::string& name) {
+  std::lock_guard lock(mu_);
+  Managed* m = find(name);
+  if (m == nullptr) throw ConfigError("activate: no instance named '" + name + "'");
+  PluginInstance& inst = *m->instance;
+  const RunState st = inst.state.load(std::memory_order_acquire);
+  if (st == RunState::active) return;
+  if (st == RunState::deactivate_requested) throw Error("activate: instance '" + name + "' is being deactivated; retry");
+  inst.call_deactivate();  // a faulted instance has not been deactivated yet if poll() did not run
+  inst.activate();
+  record({HostEvent::Type::activated, name, m->spec.loop, {}});
+}
+
+void PluginHost::deactivate(const std::string& name) {
+  std::lock_guard lock(mu_);
+  Managed* m = find(name);
+  if (m == nullptr) throw ConfigError("deactivate: no instance named '" + name + "'");
+  PluginInstance& inst = *m->instance;
+  RunState expected = RunState::active;
+  if (m->loop->running() && inst.state.compare_exchange_strong(expected, RunState::deactivate_requested)) {
+    const auto until = std::chrono::steady_clock::now() + kAdoptTimeout;
+    while (inst.state.load(std::memory_order_acquire) == RunState::deactivate_requested) {
+      if (std::chrono::steady_clock::now() > until) throw Error("deactivate: loop '" + m->spec.loop + "' did not answer");
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  } else {
+    inst.state.store(RunState::inactive, std::memory_order_release);
+    inst.drive_safe_outputs(rt::now_ns());
+  }
+  inst.call_deactivate();
+  record({HostEvent::Type::deactivated, name, m->spec.loop, {}});
+}
+
+std::string PluginHost::set_param(const std::string& name, const std::string& key, double value) {
+  std::lock_guard lock(mu_);
+  Managed* m = find(name);
+  if (m == nullptr) return "no instance named '" + name + "'";
+  return m->instance->set_param(key, value);
+}
+
+std::optional<double> PluginHost::get_param(const std::string& name, const std::string& key) const {
+  std::lock_guard lock(mu_);
+  const Managed* m = find(name);
+  double v = 0;
+  if (m == nullptr || !m->instance->get_param(key, v)) return std::nullopt;
+  return v;
+}
+
+void PluginHost::poll() {
+  std::lock_guard lock(mu_);
+  drain_locked();
+}
+
+void PluginHost::drain_locked() {
+  for (auto& l : loops_) {
+    LoopEvent e;
+    while (l->try_pop_event(e)) {
+      const std::string name = e.instance;
+      switch (e.type) {
+        case LoopEvent::Type::fault: {
+          record({HostEvent::Type::fault, name, l->spec().name, to_string(e.fault), e.cycle, e.time_ns});
+          spdlog::error("instance '{}' in loop '{}' {} at cycle {}: deactivated, outputs driven safe", name,
+                        l->spec().name, to_string(e.fault), e.cycle);
+          if (Managed* m = find(name); m && m->instance->state.load(std::memory_order_acquire) == RunState::faulted) {
+            m->instance->call_deactivate();
+          }
+          break;
+        }
+        case LoopEvent::Type::swapped:
+        case LoopEvent::Type::state_not_carried: {
+          const Managed* m = find(name);
+          std::string detail = m ? m->instance->library().plugin_name() + " " + m->instance->library().plugin_version() : "";
+          record({e.type == LoopEvent::Type::swapped ? HostEvent::Type::swapped : HostEvent::Type::swap_state_lost, name,
+                  l->spec().name, detail, e.cycle, e.time_ns});
+          break;
+        }
+        case LoopEvent::Type::deactivated: break;  // recorded by deactivate()
+      }
+    }
+    rt::LogRecord r;
+    while (l->log_queue().try_pop(r)) {
+      const std::string text = rt::format_log_record(r);
+      switch (r.level) {
+        case rt::LogLevel::debug: spdlog::debug("{}", text); break;
+        case rt::LogLevel::info: spdlog::info("{}", text); break;
+        case rt::LogLevel::warn: spdlog::warn("{}", text); break;
+        case rt::LogLevel::error: spdlog::error("{}", text); break;
+      }
+    }
+    if (l->reclaim_adopted() != nullptr) retired_.clear();
+  }
+}
+
+std::vector<InstanceInfo> PluginHost::instances() const {
+  std::lock_guard lock(mu_);
+  std::vector<InstanceInfo> out;
+  for (const Managed& m : managed_) {
+    const PluginInstance& i = *m.instance;
+    out.push_back({m.spec.name, m.spec.loop, i.library().path().string(), i.library().plugin_name(),
+                   i.library().plugin_version(), m.spec.order, i.state.load(std::memory_order_acquire),
+                   i.last_fault.load(std::memory_order_relaxed), i.stats_ptr(), i.tunables()});
+  }
+  return out;
+}
+
+std::vector<const Loop*> PluginHost::loops() const {
+  std::lock_guard lock(mu_);
+  std::vector<const Loop*> out;
+  for (const auto& l : loops_) out.push_back(l.get());
+  return out;
+}
+
+std::vector<HostEvent> PluginHost::events() const {
+  std::lock_guard lock(mu_);
+  return events_;
+}
+
+std::uint64_t PluginHost::fault_count() const {
+  std::lock_guard lock(mu_);
+  return faults_;
+}
+
+}  // namespace crease

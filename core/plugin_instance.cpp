@@ -1,0 +1,147 @@
+#include "core/plugin_instance.h"
+
+#include <cmath>
+
+#include "core/errors.h"
+#include "core/plugin.h"
+
+namespace crease {
+
+const char* to_string(RunState s) noexcept {
+  switch (s) {
+    case RunState::inactive: return "inactive";
+    case RunState::active: return "active";
+    case RunState::deactivate_requested: return "deactivating";
+    case RunState::faulted: return "faulted";
+  }
+  return "unknown";
+}
+
+const char* to_string(FaultKind k) noexcept {
+  switch (k) {
+    case FaultKind::none: return "none";
+    case FaultKind::fault_status: return "returned fault";
+    case FaultKind::threw: return "threw an exception";
+    case FaultKind::non_finite_output: return "wrote a non-finite output";
+    case FaultKind::bad_status: return "returned an unknown status";
+  }
+  return "unknown";
+}
+
+PluginInstance::PluginInstance(std::string name, std::shared_ptr<PluginLibrary> library, const Params& params,
+                               std::map<std::string, std::string> port_remap, PortRegistry& registry,
+                               rt::RtLogQueue* log, std::shared_ptr<PluginStats> stats)
+    : library_(std::move(library)),
+      d_(library_->descriptor()),
+      name_(std::move(name)),
+      stats_(std::move(stats)),
+      binder_(registry, name_, std::move(port_remap), &flags_, log),
+      param_changes_(sizeof(ParamChange), 64) {
+  const std::string who = "instance '" + name_ + "' (" + library_->path().filename().string() + ")";
+  self_ = d_.create();
+  if (self_ == nullptr) throw LoadError(who + ": the plugin could not create an instance");
+  char err[1024] = {};
+  ConfigureContext ctx{&params, &binder_};
+  if (d_.configure(self_, &ctx, err, sizeof(err)) != 0) {
+    d_.destroy(self_);
+    throw ConfigError(who + ": configure failed: " + err);
+  }
+  std::string problems;
+  for (const std::string& k : params.unused_keys()) problems += "\n  " + k + ": unknown parameter";
+  for (const std::string& p : binder_.unused_remaps()) problems += "\n  ports." + p + ": the plugin has no port '" + p + "'";
+  if (!problems.empty()) {
+    d_.cleanup(self_);
+    d_.destroy(self_);
+    throw ConfigError(who + ": configuration not understood:" + problems);
+  }
+}
+
+PluginInstance::~PluginInstance() {
+  if (self_ != nullptr) {
+    call_deactivate();
+    d_.cleanup(self_);
+    d_.destroy(self_);
+  }
+}
+
+void PluginInstance::activate() {
+  char err[1024] = {};
+  flags_.non_finite = false;
+  if (d_.activate(self_, err, sizeof(err)) != 0) {
+    throw Error("instance '" + name_ + "': activate failed: " + err);
+  }
+  hook_active_ = true;
+  last_fault.store(FaultKind::none, std::memory_order_relaxed);
+  state.store(RunState::active, std::memory_order_release);
+}
+
+void PluginInstance::call_deactivate() noexcept {
+  if (!hook_active_) return;
+  hook_active_ = false;
+  d_.deactivate(self_);
+}
+
+void PluginInstance::drive_safe_outputs(std::int64_t stamp_ns) noexcept {
+  for (const SafeOutput& o : binder_.safe_outputs()) o.channel->write(o.safe_value.data(), stamp_ns);
+}
+
+std::string PluginInstance::set_param(const std::string& key, double value) {
+  auto& ts = binder_.tunables();
+  for (std::uint32_t i = 0; i < ts.size(); ++i) {
+    Tunable& t = ts[i];
+    if (t.key != key) continue;
+    if (!std::isfinite(value) || value < t.lo || value > t.hi) {
+      return "value " + std::to_string(value) + " for '" + key + "' is outside [" + std::to_string(t.lo) + ", " +
+             std::to_string(t.hi) + "]";
+    }
+    char err[512] = {};
+    if (d_.validate_param(self_, key.c_str(), value, err, sizeof(err)) != 0) return std::string("refused: ") + err;
+    const ParamChange c{i, value};
+    if (!param_changes_.try_push(&c)) return "too many changes pending; try again";
+    t.value = value;
+    return {};
+  }
+  return "instance '" + name_ + "' has no tunable parameter '" + key + "'";
+}
+
+bool PluginInstance::get_param(const std::string& key, double& value) const {
+  for (const Tunable& t : binder_.tunables()) {
+    if (t.key == key) {
+      value = t.value;
+      return true;
+    }
+  }
+  return false;
+}
+
+void PluginInstance::apply_param_changes_rt() noexcept {
+  ParamChange c;
+  auto& ts = binder_.tunables();
+  while (param_changes_.try_pop(&c)) {
+    if (c.index < ts.size()) *ts[c.index].target = c.value;
+  }
+}
+
+FaultKind PluginInstance::update_rt(const crease_cycle& cycle, Status& status) noexcept {
+  const std::int32_t code = d_.update(self_, &cycle);
+  FaultKind kind = FaultKind::none;
+  if (flags_.non_finite) {
+    kind = FaultKind::non_finite_output;
+  } else if (code == 2) {
+    kind = FaultKind::fault_status;
+  } else if (code == 3) {
+    kind = FaultKind::threw;
+  } else if (code != 0 && code != 1) {
+    kind = FaultKind::bad_status;
+  }
+  status = kind == FaultKind::none ? static_cast<Status>(code) : Status::fault;
+  if (kind != FaultKind::none) {
+    drive_safe_outputs(cycle.time_ns);
+    last_code.store(code, std::memory_order_relaxed);
+    last_fault.store(kind, std::memory_order_relaxed);
+    state.store(RunState::faulted, std::memory_order_release);
+  }
+  return kind;
+}
+
+}  // namespace crease

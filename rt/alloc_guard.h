@@ -1,0 +1,43 @@
+// Marks threads as real-time and counts heap allocations made on them.
+//
+// Every loop thread marks itself RT. Counting needs the allocation hooks
+// (library crease_rt_alloc_hooks, linked into tests and crease-bench only): they
+// replace the global operator new/delete and count calls made on RT-marked threads.
+// Production binaries do not link the hooks and pay one thread_local store per thread.
+#pragma once
+
+#include <cstdint>
+
+namespace crease::rt {
+
+// Marks (or unmarks) the calling thread as real-time. RT-safe.
+void mark_this_thread_rt(bool is_rt) noexcept;
+[[nodiscard]] bool this_thread_is_rt() noexcept;
+
+// Allocations (operator new, new[], and their aligned/nothrow forms) and frees made on
+// RT-marked threads since the process started. Always 0 unless the hooks are linked.
+[[nodiscard]] std::uint64_t rt_allocation_count() noexcept;
+[[nodiscard]] std::uint64_t rt_free_count() noexcept;
+// True when crease_rt_alloc_hooks is linked in, i.e. the counts above mean something.
+[[nodiscard]] bool alloc_hooks_installed() noexcept;
+
+// Marks the calling thread RT for a scope (library tests: wrap the steady-state step).
+class ScopedRtMark {
+ public:
+  ScopedRtMark() noexcept : was_rt_(this_thread_is_rt()) { mark_this_thread_rt(true); }
+  ~ScopedRtMark() { mark_this_thread_rt(was_rt_); }
+  ScopedRtMark(const ScopedRtMark&) = delete;
+  ScopedRtMark& operator=(const ScopedRtMark&) = delete;
+
+ private:
+  bool was_rt_;
+};
+
+namespace detail {
+// Called by the hooks; not for general use.
+void note_rt_allocation() noexcept;
+void note_rt_free() noexcept;
+void note_hooks_installed() noexcept;
+}  // namespace detail
+
+}  // namespace crease::rt

@@ -1,0 +1,70 @@
+#include "rt/latest.h"
+
+namespace crease::rt {
+
+LatestChannel::LatestChannel(std::size_t payload_size)
+    : size_(payload_size),
+      words_((payload_size + 7) / 8),
+      headers_(new SlotHeader[kSlots]),
+      payload_(new Word[kSlots * words_]) {
+  for (std::size_t i = 0; i < kSlots * words_; ++i) payload_[i].store(0, std::memory_order_relaxed);
+}
+
+void LatestChannel::write(const void* data, std::int64_t stamp_ns) noexcept {
+  const std::uint64_t version = latest_.load(std::memory_order_relaxed) + 1;
+  const std::size_t slot = version % kSlots;
+  SlotHeader& h = header(slot);
+  h.seq.store(2 * version - 1, std::memory_order_relaxed);  // odd: being written
+  std::atomic_thread_fence(std::memory_order_release);
+  h.stamp_ns.store(stamp_ns, std::memory_order_relaxed);
+  Word* dst = words(slot);
+  const auto* src = static_cast<const unsigned char*>(data);
+  const std::size_t full = size_ / 8;
+  for (std::size_t w = 0; w < full; ++w) {
+    std::uint64_t v;
+    std::memcpy(&v, src + 8 * w, 8);
+    dst[w].store(v, std::memory_order_relaxed);
+  }
+  if (const std::size_t tail = size_ - 8 * full; tail != 0) {
+    std::uint64_t v = 0;
+    std::memcpy(&v, src + 8 * full, tail);
+    dst[full].store(v, std::memory_order_relaxed);
+  }
+  h.seq.store(2 * version, std::memory_order_release);  // even: stable
+  latest_.store(version, std::memory_order_release);
+}
+
+ReadInfo LatestChannel::read(void* out, std::uint64_t last_seen_seq) const noexcept {
+  auto* dst = static_cast<unsigned char*>(out);
+  for (int attempt = 0; attempt < kMaxReadTries; ++attempt) {
+    const std::uint64_t version = latest_.load(std::memory_order_acquire);
+    if (version == 0) return ReadInfo{};
+    if (version == last_seen_seq) {
+      // Nothing new: report the old value's identity without copying (the caller has it).
+      return ReadInfo{Flow::old_data, version, header(version % kSlots).stamp_ns.load(std::memory_order_relaxed)};
+    }
+    const std::size_t slot = version % kSlots;
+    const SlotHeader& h = header(slot);
+    const std::uint64_t before = h.seq.load(std::memory_order_acquire);
+    if (before != 2 * version) continue;  // already being overwritten: take the newer one
+    const std::int64_t stamp = h.stamp_ns.load(std::memory_order_relaxed);
+    const Word* src = words(slot);
+    const std::size_t full = size_ / 8;
+    for (std::size_t w = 0; w < full; ++w) {
+      const std::uint64_t v = src[w].load(std::memory_order_relaxed);
+      std::memcpy(dst + 8 * w, &v, 8);
+    }
+    if (const std::size_t tail = size_ - 8 * full; tail != 0) {
+      const std::uint64_t v = src[full].load(std::memory_order_relaxed);
+      std::memcpy(dst + 8 * full, &v, tail);
+    }
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (h.seq.load(std::memory_order_relaxed) == before) {
+      return ReadInfo{Flow::new_data, version, stamp};
+    }
+  }
+  give_ups_.fetch_add(1, std::memory_order_relaxed);
+  return ReadInfo{last_seen_seq == 0 ? Flow::no_data : Flow::old_data, last_seen_seq, 0};
+}
+
+}  // namespace crease::rt

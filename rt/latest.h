@@ -1,0 +1,121 @@
+// `latest` channel: the newest value of a piece of state, one writer, any number of readers.
+//
+// A ring of kSlots seqlocked slots. The writer fills the slot after the newest one and then
+// publishes its sequence number: write is wait-free. A reader copies the newest slot and checks
+// that the slot's sequence did not change while it copied; it retries (at most kMaxReadTries
+// times) only if the writer lapped the whole ring during one copy, so reads are wait-free in
+// practice and bounded always. Payload words are copied with relaxed atomics so that the race a
+// seqlock tolerates by design is not undefined behaviour (and ThreadSanitizer agrees).
+// The channel is type-erased (bytes) so that it outlives the plugin library that wrote it.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <new>
+
+namespace crease::rt {
+
+// What a read found (OROCOS's FlowStatus).
+enum class Flow : std::uint8_t {
+  no_data,   // never written
+  old_data,  // the value the reader already saw
+  new_data,  // a value newer than the reader last saw
+};
+
+struct ReadInfo {
+  Flow flow = Flow::no_data;
+  std::uint64_t seq = 0;      // 1 for the first value written, +1 per write; 0 = none
+  std::int64_t stamp_ns = 0;  // writer's CLOCK_MONOTONIC timestamp of the value
+  [[nodiscard]] bool has_data() const noexcept { return flow != Flow::no_data; }
+  [[nodiscard]] bool is_new() const noexcept { return flow == Flow::new_data; }
+};
+
+class LatestChannel {
+ public:
+  static constexpr std::size_t kSlots = 4;
+  static constexpr int kMaxReadTries = 64;
+
+  // Allocates every slot now (non-RT). payload_size > 0.
+  explicit LatestChannel(std::size_t payload_size);
+  LatestChannel(const LatestChannel&) = delete;
+  LatestChannel& operator=(const LatestChannel&) = delete;
+
+  [[nodiscard]] std::size_t payload_size() const noexcept { return size_; }
+
+  // Single writer. Wait-free, RT-safe. `data` points at payload_size() bytes.
+  void write(const void* data, std::int64_t stamp_ns) noexcept;
+
+  // Any thread. Copies the newest value into `out` (payload_size() bytes) when there is one;
+  // `last_seen_seq` decides old vs new. Bounded retries; RT-safe. If the writer kept lapping the
+  // reader for kMaxReadTries attempts, returns old_data with the reader's last_seen_seq and
+  // leaves `out` untouched.
+  ReadInfo read(void* out, std::uint64_t last_seen_seq) const noexcept;
+
+  // Newest published sequence number (0 = never written). Any thread.
+  [[nodiscard]] std::uint64_t sequence() const noexcept {
+    return latest_.load(std::memory_order_acquire);
+  }
+  // Reads that gave up after kMaxReadTries (should stay 0).
+  [[nodiscard]] std::uint64_t read_give_ups() const noexcept {
+    return give_ups_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  struct SlotHeader {
+    std::atomic<std::uint64_t> seq{0};  // 2*version when stable, odd while being written
+    std::atomic<std::int64_t> stamp_ns{0};
+  };
+  using Word = std::atomic<std::uint64_t>;
+  static_assert(Word::is_always_lock_free);
+
+  [[nodiscard]] SlotHeader& header(std::size_t i) const noexcept { return headers_[i]; }
+  [[nodiscard]] Word* words(std::size_t i) const noexcept { return payload_.get() + i * words_; }
+
+  std::size_t size_;
+  std::size_t words_;  // payload words per slot (size rounded up to 8 bytes)
+  std::unique_ptr<SlotHeader[]> headers_;
+  std::unique_ptr<Word[]> payload_;
+  // Separate cache line: readers poll it, the writer bumps it once per write.
+  alignas(64) std::atomic<std::uint64_t> latest_{0};
+  mutable std::atomic<std::uint64_t> give_ups_{0};
+};
+
+// Typed ends over a LatestChannel. T must be trivially copyable.
+template <class T>
+class LatestWriter {
+  static_assert(std::is_trivially_copyable_v<T>, "port payloads are plain structs");
+
+ public:
+  LatestWriter() = default;
+  explicit LatestWriter(LatestChannel* ch) noexcept : ch_(ch) {}
+  void write(const T& v, std::int64_t stamp_ns) noexcept { ch_->write(&v, stamp_ns); }
+  [[nodiscard]] bool bound() const noexcept { return ch_ != nullptr; }
+
+ private:
+  LatestChannel* ch_ = nullptr;
+};
+
+template <class T>
+class LatestReader {
+  static_assert(std::is_trivially_copyable_v<T>, "port payloads are plain structs");
+
+ public:
+  LatestReader() = default;
+  explicit LatestReader(const LatestChannel* ch) noexcept : ch_(ch) {}
+  // Copies the newest value into `out` if there is one; tells whether it is new to this reader.
+  ReadInfo read(T& out) noexcept {
+    ReadInfo info = ch_->read(&out, last_seen_);
+    if (info.has_data()) last_seen_ = info.seq;
+    return info;
+  }
+  [[nodiscard]] bool bound() const noexcept { return ch_ != nullptr; }
+
+ private:
+  const LatestChannel* ch_ = nullptr;
+  std::uint64_t last_seen_ = 0;
+};
+
+}  // namespace crease::rt
