@@ -1,6 +1,15 @@
 #include "core/params.h"
 
+#include <cstdio>
+
 namespace crease {
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.10g", v);
+  return buf;
+}
+
 namespace {
 std::string mark_text(const YAML::Node& n) {
   if (!n) return "";

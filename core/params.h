@@ -18,6 +18,9 @@
 
 namespace crease {
 
+// Shortest readable form of a number for messages ("0.5", "100", "1e-06").
+std::string format_number(double v);
+
 class Params {
  public:
   Params();  // an empty map, for plugins configured without parameters
@@ -44,7 +47,7 @@ class Params {
   [[nodiscard]] T get_in_range(std::string_view key, T fallback, T lo, T hi) const {
     const T v = get<T>(key, fallback);
     if (!(v >= lo && v <= hi)) {
-      fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(v));
+      fail(key, "must be in [" + format_number(lo) + ", " + format_number(hi) + "], got " + format_number(v));
     }
     return v;
   }

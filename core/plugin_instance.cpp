@@ -91,8 +91,8 @@ std::string PluginInstance::set_param(const std::string& key, double value) {
     Tunable& t = ts[i];
     if (t.key != key) continue;
     if (!std::isfinite(value) || value < t.lo || value > t.hi) {
-      return "value " + std::to_string(value) + " for '" + key + "' is outside [" + std::to_string(t.lo) + ", " +
-             std::to_string(t.hi) + "]";
+      return "value " + format_number(value) + " for '" + key + "' is outside [" + format_number(t.lo) + ", " +
+             format_number(t.hi) + "]";
     }
     char err[512] = {};
     if (d_.validate_param(self_, key.c_str(), value, err, sizeof(err)) != 0) return std::string("refused: ") + err;

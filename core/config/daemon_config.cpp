@@ -1,0 +1,345 @@
+#include "core/config/daemon_config.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/config/yaml_reader.h"
+
+namespace crease::config {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kMaxRateHz = 20000.0;
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || !(s[0] >= 'a' && s[0] <= 'z')) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+  });
+}
+
+bool has_space(const std::string& s) {
+  return std::any_of(s.begin(), s.end(), [](char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\0';
+  });
+}
+
+std::string index_path(const std::string& key, std::size_t i) {
+  return key + "[" + std::to_string(i) + "]";
+}
+
+std::string read_identifier(const std::string& file, const YAML::Node& node,
+                            const std::string& path) {
+  std::string s = read_string(file, node, path);
+  if (!is_identifier(s)) {
+    throw ConfigError(loc_of(file, node), path,
+                      "'" + s + "' is not a valid name ([a-z][a-z0-9_]*)");
+  }
+  return s;
+}
+
+// Resolves P against the config file's folder unless absolute.
+std::string resolve(const std::string& file, const std::string& p) {
+  const fs::path path(p);
+  if (path.is_absolute()) return path.lexically_normal().string();
+  fs::path base = fs::path(file).parent_path();
+  if (base.empty()) base = ".";
+  return (base / path).lexically_normal().string();
+}
+
+void read_plugin_dirs(const MapReader& root, const LoadOptions& options, DaemonConfig& cfg) {
+  const YAML::Node dirs = root.require("plugin_dirs");
+  const std::string& file = root.file();
+  if (!dirs.IsSequence() || dirs.size() == 0) {
+    throw ConfigError(loc_of(file, dirs), "plugin_dirs", "expected a non-empty list of folders");
+  }
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    const std::string path = index_path("plugin_dirs", i);
+    const std::string dir = resolve(file, read_string(file, dirs[i], path));
+    if (options.check_plugin_dirs_exist) {
+      std::error_code ec;
+      if (!fs::is_directory(dir, ec)) {
+        throw ConfigError(loc_of(file, dirs[i]), path, "'" + dir + "' is not a directory");
+      }
+    }
+    cfg.plugin_dirs.push_back(dir);
+  }
+}
+
+void read_daemon(const MapReader& root, DaemonConfig& cfg) {
+  if (!root.has("daemon")) return;
+  const MapReader m(root.file(), root.get("daemon"), "daemon",
+                    {"socket", "socket_group", "report_dir", "duration_s", "lock_memory",
+                     "prefault_heap_mb", "cpu_dma_latency_us"});
+  const std::string& f = m.file();
+  DaemonSettings& d = cfg.daemon;
+  d.loc = m.loc();
+  if (m.has("socket")) {
+    d.socket = resolve(f, read_string(f, m.get("socket"), m.path_of("socket")));
+  }
+  if (m.has("socket_group")) {
+    d.socket_group = read_string(f, m.get("socket_group"), m.path_of("socket_group"));
+  }
+  if (m.has("report_dir")) {
+    d.report_dir = resolve(f, read_string(f, m.get("report_dir"), m.path_of("report_dir")));
+  }
+  if (m.has("duration_s")) {
+    d.duration_s = read_number(f, m.get("duration_s"), m.path_of("duration_s"), 0.0, 1e9, true);
+  }
+  if (m.has("lock_memory")) {
+    d.lock_memory = read_bool(f, m.get("lock_memory"), m.path_of("lock_memory"));
+  }
+  if (m.has("prefault_heap_mb")) {
+    d.prefault_heap_mb = static_cast<int>(
+        read_int(f, m.get("prefault_heap_mb"), m.path_of("prefault_heap_mb"), 0, 65536));
+  }
+  if (m.has("cpu_dma_latency_us")) {
+    d.cpu_dma_latency_us = static_cast<int>(read_int(
+        f, m.get("cpu_dma_latency_us"), m.path_of("cpu_dma_latency_us"), 0, 100000000));
+  }
+}
+
+void read_loops(const MapReader& root, DaemonConfig& cfg) {
+  const std::string& f = root.file();
+  const YAML::Node loops = root.require("loops");
+  if (!loops.IsSequence() || loops.size() == 0) {
+    throw ConfigError(loc_of(f, loops), "loops", "expected a non-empty list of loops");
+  }
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    const MapReader m(f, loops[i], index_path("loops", i),
+                      {"name", "rate_hz", "priority", "cpu", "overrun"});
+    LoopConfig loop;
+    loop.loc = m.loc();
+    loop.name = read_identifier(f, m.require("name"), m.path_of("name"));
+    for (const auto& other : cfg.loops) {
+      if (other.name == loop.name) {
+        throw ConfigError(loc_of(f, m.get("name")), m.path_of("name"),
+                          "duplicate loop name '" + loop.name + "' (first at " +
+                              other.loc.str() + ")");
+      }
+    }
+    loop.rate_hz = read_number(f, m.require("rate_hz"), m.path_of("rate_hz"), 0.0, kMaxRateHz,
+                               true);
+    loop.priority = static_cast<int>(read_int(f, m.require("priority"), m.path_of("priority"), 0, 99));
+    if (m.has("cpu")) {
+      loop.cpu = static_cast<int>(read_int(f, m.get("cpu"), m.path_of("cpu"), -1, 1023));
+    }
+    if (m.has("overrun")) {
+      const std::string o = read_string(f, m.get("overrun"), m.path_of("overrun"));
+      if (o != "skip") {
+        throw ConfigError(loc_of(f, m.get("overrun")), m.path_of("overrun"),
+                          "unknown overrun policy '" + o + "' (only 'skip' is supported)");
+      }
+    }
+    cfg.loops.push_back(std::move(loop));
+  }
+}
+
+void read_ports(const std::string& f, const MapReader& m, PluginConfig& p) {
+  if (!m.has("ports")) return;
+  const YAML::Node ports = m.get("ports");
+  const std::string path = m.path_of("ports");
+  if (!ports.IsMap()) throw ConfigError(loc_of(f, ports), path, "expected a map local: global");
+  for (auto it = ports.begin(); it != ports.end(); ++it) {
+    const std::string local = read_string(f, it->first, path);
+    const std::string kp = path + "." + local;
+    if (has_space(local)) throw ConfigError(loc_of(f, it->first), kp, "port names have no spaces");
+    if (p.ports.count(local) != 0) {
+      throw ConfigError(loc_of(f, it->first), kp, "duplicate port '" + local + "'");
+    }
+    const std::string global = read_string(f, it->second, kp);
+    if (has_space(global)) throw ConfigError(loc_of(f, it->second), kp, "port names have no spaces");
+    p.ports.emplace(local, global);
+  }
+}
+
+void read_plugins(const MapReader& root, DaemonConfig& cfg) {
+  const std::string& f = root.file();
+  if (!root.has("plugins")) return;
+  const YAML::Node plugins = root.get("plugins");
+  if (plugins.IsNull()) return;
+  if (!plugins.IsSequence()) {
+    throw ConfigError(loc_of(f, plugins), "plugins", "expected a list of plugin instances");
+  }
+  for (std::size_t i = 0; i < plugins.size(); ++i) {
+    const MapReader m(f, plugins[i], index_path("plugins", i),
+                      {"name", "library", "loop", "order", "enabled", "params", "ports"});
+    PluginConfig p;
+    p.loc = m.loc();
+    p.params_loc = p.loc;
+    p.name = read_identifier(f, m.require("name"), m.path_of("name"));
+    for (const auto& other : cfg.plugins) {
+      if (other.name == p.name) {
+        throw ConfigError(loc_of(f, m.get("name")), m.path_of("name"),
+                          "duplicate plugin name '" + p.name + "' (first at " +
+                              other.loc.str() + ")");
+      }
+    }
+    p.library = read_string(f, m.require("library"), m.path_of("library"));
+    if (has_space(p.library)) {
+      throw ConfigError(loc_of(f, m.get("library")), m.path_of("library"),
+                        "library names have no spaces");
+    }
+    if (p.library.find('/') != std::string::npos) p.library = resolve(f, p.library);
+    const YAML::Node loop_node = m.require("loop");
+    p.loop = read_string(f, loop_node, m.path_of("loop"));
+    if (cfg.find_loop(p.loop) == nullptr) {
+      std::vector<std::string> names;
+      for (const auto& l : cfg.loops) names.push_back(l.name);
+      std::string reason = "unknown loop '" + p.loop + "'";
+      const std::string guess = did_you_mean(p.loop, names);
+      if (!guess.empty()) reason += " (did you mean '" + guess + "'?)";
+      throw ConfigError(loc_of(f, loop_node), m.path_of("loop"), reason);
+    }
+    const YAML::Node order_node = m.require("order");
+    p.order = static_cast<int>(read_int(f, order_node, m.path_of("order"), -1000000, 1000000));
+    for (const auto& other : cfg.plugins) {
+      if (other.loop == p.loop && other.order == p.order) {
+        throw ConfigError(loc_of(f, order_node), m.path_of("order"),
+                          "order " + std::to_string(p.order) + " is already used by '" +
+                              other.name + "' in loop '" + p.loop + "'");
+      }
+    }
+    if (m.has("enabled")) p.enabled = read_bool(f, m.get("enabled"), m.path_of("enabled"));
+    if (m.has("params")) {
+      const YAML::Node params = m.get("params");
+      if (params.IsNull()) {
+        p.params = YAML::Node(YAML::NodeType::Map);
+      } else if (!params.IsMap()) {
+        throw ConfigError(loc_of(f, params), m.path_of("params"), "expected a map");
+      } else {
+        p.params = params;
+        p.params_loc = loc_of(f, params);
+      }
+    } else {
+      p.params = YAML::Node(YAML::NodeType::Map);
+    }
+    read_ports(f, m, p);
+    cfg.plugins.push_back(std::move(p));
+  }
+}
+
+void read_safety(const MapReader& root, DaemonConfig& cfg) {
+  if (!root.has("safety")) return;
+  const MapReader m(root.file(), root.get("safety"), "safety", {"on_fault", "max_overruns_per_s"});
+  const std::string& f = m.file();
+  cfg.safety.loc = m.loc();
+  if (m.has("on_fault")) {
+    const std::string v = read_string(f, m.get("on_fault"), m.path_of("on_fault"));
+    if (v == "deactivate") {
+      cfg.safety.on_fault = FaultPolicy::deactivate;
+    } else if (v == "stop") {
+      cfg.safety.on_fault = FaultPolicy::stop;
+    } else {
+      throw ConfigError(loc_of(f, m.get("on_fault")), m.path_of("on_fault"),
+                        "expected 'deactivate' or 'stop', got '" + v + "'");
+    }
+  }
+  if (m.has("max_overruns_per_s")) {
+    cfg.safety.max_overruns_per_s = read_number(f, m.get("max_overruns_per_s"),
+                                                m.path_of("max_overruns_per_s"), 0.0, 1e9, false);
+  }
+}
+
+}  // namespace
+
+std::string SourceLoc::str() const {
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+ConfigError::ConfigError(SourceLoc loc, std::string key_path, std::string reason)
+    : std::runtime_error(loc.str() + ": " + key_path + ": " + reason),
+      loc_(std::move(loc)),
+      key_path_(std::move(key_path)),
+      reason_(std::move(reason)) {}
+
+ConfigError error_at(const std::string& file, const YAML::Node& node, const std::string& key_path,
+                     const std::string& reason) {
+  return ConfigError(loc_of(file, node), key_path, reason);
+}
+
+std::int64_t LoopConfig::period_ns() const noexcept {
+  return static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
+}
+
+const LoopConfig* DaemonConfig::find_loop(const std::string& name) const {
+  for (const auto& l : loops) {
+    if (l.name == name) return &l;
+  }
+  return nullptr;
+}
+
+const PluginConfig* DaemonConfig::find_plugin(const std::string& name) const {
+  for (const auto& p : plugins) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+std::vector<const PluginConfig*> DaemonConfig::plugins_of_loop(const std::string& loop) const {
+  std::vector<const PluginConfig*> out;
+  for (const auto& p : plugins) {
+    if (p.loop == loop) out.push_back(&p);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const PluginConfig* a, const PluginConfig* b) { return a->order < b->order; });
+  return out;
+}
+
+DaemonConfig load_daemon_config_from_string(const std::string& text,
+                                            const std::string& virtual_file,
+                                            const LoadOptions& options) {
+  YAML::Node doc;
+  try {
+    doc = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(SourceLoc{virtual_file, e.mark.line + 1, e.mark.column + 1}, "(syntax)",
+                      e.msg);
+  }
+  if (!doc.IsMap()) {
+    SourceLoc loc = loc_of(virtual_file, doc);
+    if (loc.line == 0) loc = SourceLoc{virtual_file, 1, 1};
+    throw ConfigError(loc, "(document)", "expected a map with plugin_dirs, loops and plugins");
+  }
+  const MapReader root(virtual_file, doc, "",
+                       {"plugin_dirs", "daemon", "loops", "plugins", "safety"});
+  DaemonConfig cfg;
+  cfg.file = virtual_file;
+  read_plugin_dirs(root, options, cfg);
+  read_daemon(root, cfg);
+  read_loops(root, cfg);
+  read_plugins(root, cfg);
+  read_safety(root, cfg);
+  return cfg;
+}
+
+DaemonConfig load_daemon_config(const std::string& path, const LoadOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw ConfigError(SourceLoc{path, 0, 0}, "(file)", "cannot read the configuration file");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return load_daemon_config_from_string(text.str(), path, options);
+}
+
+const char* to_string(OverrunPolicy p) noexcept {
+  switch (p) {
+    case OverrunPolicy::skip: return "skip";
+  }
+  return "?";
+}
+
+const char* to_string(FaultPolicy p) noexcept {
+  switch (p) {
+    case FaultPolicy::deactivate: return "deactivate";
+    case FaultPolicy::stop: return "stop";
+  }
+  return "?";
+}
+
+}  // namespace crease::config

@@ -1,0 +1,131 @@
+// The daemon's YAML configuration as plain structs, loaded and validated completely.
+//
+//   crease::config::DaemonConfig cfg = crease::config::load_daemon_config("config/sim.yaml");
+//
+// Every error throws ConfigError before anything is returned; its what() reads
+//   FILE:LINE:COLUMN: KEY.PATH: reason        (1-based line and column)
+// e.g. "sim.yaml:14:5: plugins[2].loop: unknown loop 'contrl' (did you mean 'control'?)".
+// Unknown keys are errors. Durations are seconds, rates Hz. Plugin parameters are kept as
+// YAML nodes (with their marks) for the owning plugin to validate.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace crease::config {
+
+// Where an item came from, so later errors (plugin load, parameter validation) can point
+// back to it. line/column are 1-based; 0 when unknown.
+struct SourceLoc {
+  std::string file;
+  int line = 0;
+  int column = 0;
+
+  // "FILE:LINE:COLUMN"
+  [[nodiscard]] std::string str() const;
+};
+
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(SourceLoc loc, std::string key_path, std::string reason);
+
+  [[nodiscard]] const SourceLoc& loc() const noexcept { return loc_; }
+  [[nodiscard]] const std::string& key_path() const noexcept { return key_path_; }
+  [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
+
+ private:
+  SourceLoc loc_;
+  std::string key_path_;
+  std::string reason_;
+};
+
+// "FILE:LINE:COLUMN: KEY.PATH: reason" for a YAML node of a loaded config; a plugin that
+// rejects one of its params uses this so its message points into the config file.
+[[nodiscard]] ConfigError error_at(const std::string& file, const YAML::Node& node,
+                                   const std::string& key_path, const std::string& reason);
+
+struct DaemonSettings {
+  std::optional<std::string> socket;        // control socket path; absent: creased's default
+  std::optional<std::string> socket_group;  // group allowed on the socket (0660)
+  std::optional<std::string> report_dir;    // resolved against the config file's folder
+  std::optional<double> duration_s;         // > 0; absent: run until stopped
+  bool lock_memory = true;                  // mlockall(MCL_CURRENT|MCL_FUTURE) + prefault
+  int prefault_heap_mb = 64;                // >= 0, heap touched at start when lock_memory
+  std::optional<int> cpu_dma_latency_us;    // >= 0; absent: /dev/cpu_dma_latency untouched
+  SourceLoc loc;
+};
+
+enum class OverrunPolicy { skip };  // missed periods are skipped and counted
+
+struct LoopConfig {
+  std::string name;   // [a-z][a-z0-9_]*
+  double rate_hz = 0; // (0, 20000]
+  int priority = 0;   // 0 = SCHED_OTHER, 1..99 = SCHED_FIFO
+  int cpu = -1;       // -1 = any, else 0..1023
+  OverrunPolicy overrun = OverrunPolicy::skip;
+  SourceLoc loc;
+
+  // Period in CLOCK_MONOTONIC ns, rounded to the nearest ns.
+  [[nodiscard]] std::int64_t period_ns() const noexcept;
+};
+
+struct PluginConfig {
+  std::string name;     // instance name, [a-z][a-z0-9_]*, unique
+  std::string library;  // "crease_counter" -> libcrease_counter.so in a plugin dir, or a path
+  std::string loop;     // names a LoopConfig
+  int order = 0;        // run order within the loop (ascending); unique per loop
+  bool enabled = true;
+  YAML::Node params;    // a map (possibly empty), marks kept; validated by the plugin
+  std::map<std::string, std::string> ports;  // local port name -> global port name
+  SourceLoc loc;        // the list item
+  SourceLoc params_loc; // the params map, or the item when absent
+};
+
+enum class FaultPolicy { deactivate, stop };
+
+struct SafetyConfig {
+  FaultPolicy on_fault = FaultPolicy::deactivate;
+  double max_overruns_per_s = 0;  // 0 = no limit; else stop when exceeded
+  SourceLoc loc;
+};
+
+struct DaemonConfig {
+  std::string file;                      // as given (or the virtual name)
+  std::vector<std::string> plugin_dirs;  // absolute or resolved against the file's folder
+  DaemonSettings daemon;
+  std::vector<LoopConfig> loops;         // in file order
+  std::vector<PluginConfig> plugins;     // in file order
+  SafetyConfig safety;
+
+  [[nodiscard]] const LoopConfig* find_loop(const std::string& name) const;
+  [[nodiscard]] const PluginConfig* find_plugin(const std::string& name) const;
+  // Plugins of one loop sorted by order.
+  [[nodiscard]] std::vector<const PluginConfig*> plugins_of_loop(const std::string& loop) const;
+};
+
+struct LoadOptions {
+  // Refuse plugin_dirs that do not exist or are not directories.
+  bool check_plugin_dirs_exist = true;
+};
+
+// Loads FILE; relative paths resolve against FILE's folder.
+// @throws ConfigError (also for an unreadable file: "FILE:0:0: (file): cannot read: ...").
+[[nodiscard]] DaemonConfig load_daemon_config(const std::string& path,
+                                              const LoadOptions& options = {});
+
+// Parses TEXT as if read from VIRTUAL_FILE (used in messages and to resolve relative paths).
+// @throws ConfigError
+[[nodiscard]] DaemonConfig load_daemon_config_from_string(const std::string& text,
+                                                          const std::string& virtual_file,
+                                                          const LoadOptions& options = {});
+
+[[nodiscard]] const char* to_string(OverrunPolicy p) noexcept;
+[[nodiscard]] const char* to_string(FaultPolicy p) noexcept;
+
+}  // namespace crease::config

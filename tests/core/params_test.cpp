@@ -1,0 +1,55 @@
+#include "core/params.h"
+
+#include <doctest/doctest.h>
+
+#include <string>
+
+namespace {
+crease::Params parse(const std::string& yaml) {
+  return crease::Params(YAML::Load(yaml), "sim.yaml", "plugins[0].params");
+}
+std::string error_of(auto&& fn) {
+  try {
+    fn();
+  } catch (const crease::ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+}  // namespace
+
+TEST_CASE("typed access with defaults and ranges") {
+  const auto p = parse("gain: 2.5\nname: left\ncount: 3\nflag: true\n");
+  CHECK(p.get<double>("gain") == 2.5);
+  CHECK(p.get<std::string>("name") == "left");
+  CHECK(p.get<int>("count") == 3);
+  CHECK(p.get<bool>("flag"));
+  CHECK(p.get<double>("missing", 7.0) == 7.0);
+  CHECK(p.get_in_range<int>("count", 0, 1, 5) == 3);
+}
+
+TEST_CASE("errors name the file, line, column and key") {
+  const auto p = parse("gain: fast\ncount: 9\nnested:\n  k: [1, 2]\n");
+  CHECK(error_of([&] { (void)p.get<double>("gain"); }) ==
+        "sim.yaml:1:7: plugins[0].params.gain: expected a number, got 'fast'");
+  CHECK(error_of([&] { (void)p.get<double>("absent"); }).find("plugins[0].params.absent: required parameter is missing") !=
+        std::string::npos);
+  CHECK(error_of([&] { (void)p.get_in_range<int>("count", 0, 1, 5); }) ==
+        "sim.yaml:2:8: plugins[0].params.count: must be in [1, 5], got 9");
+  CHECK(error_of([&] { (void)p.child("nested").get<int>("k"); }) ==
+        "sim.yaml:4:6: plugins[0].params.nested.k: expected an integer, got a list");
+}
+
+TEST_CASE("keys never read are reported, including inside opened child maps") {
+  const auto p = parse("gain: 1\ngian: 2\nsub:\n  a: 1\n  b: 2\n");
+  (void)p.get<double>("gain");
+  (void)p.child("sub").get<int>("a");
+  const auto unused = p.unused_keys();
+  REQUIRE(unused.size() == 2);
+  CHECK(unused[0] == "sim.yaml:2:7: plugins[0].params.gian");
+  CHECK(unused[1] == "sim.yaml:5:6: plugins[0].params.sub.b");
+}
+
+TEST_CASE("a non-map is refused") {
+  CHECK(error_of([] { parse("[1, 2]"); }).find("expected a map of parameters") != std::string::npos);
+}

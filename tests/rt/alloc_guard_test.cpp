@@ -1,0 +1,31 @@
+#include "rt/alloc_guard.h"
+
+#include <doctest/doctest.h>
+
+#include <memory>
+#include <thread>
+#include <vector>
+
+TEST_CASE("the hooks are linked into tests") { CHECK(crease::rt::alloc_hooks_installed()); }
+
+TEST_CASE("allocations on RT-marked threads are counted; others are not") {
+  const auto before = crease::rt::rt_allocation_count();
+  auto p = std::make_unique<int>(1);  // not RT: not counted
+  CHECK(crease::rt::rt_allocation_count() == before);
+  {
+    crease::rt::ScopedRtMark mark;
+    auto q = std::make_unique<int>(2);
+    std::vector<double> v(10);
+    CHECK(crease::rt::rt_allocation_count() == before + 2);
+  }
+  CHECK(crease::rt::rt_free_count() >= 2);
+  CHECK_FALSE(crease::rt::this_thread_is_rt());
+}
+
+TEST_CASE("the mark is per thread") {
+  crease::rt::ScopedRtMark mark;
+  bool other_is_rt = true;
+  std::thread([&] { other_is_rt = crease::rt::this_thread_is_rt(); }).join();
+  CHECK_FALSE(other_is_rt);
+  CHECK(crease::rt::this_thread_is_rt());
+}
