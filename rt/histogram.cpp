@@ -48,11 +48,11 @@ void Histogram::note_worst(std::uint64_t v, std::uint64_t cycle, std::int64_t ti
     if (worst_value_[i].load(std::memory_order_relaxed) < worst_value_[victim].load(std::memory_order_relaxed)) victim = i;
   }
   const std::uint64_t s = worst_seq_.load(std::memory_order_relaxed);
+  // A small seqlock; release stores / acquire loads instead of fences (see rt/latest.cpp).
   worst_seq_.store(s + 1, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  worst_value_[victim].store(v, std::memory_order_relaxed);
-  worst_cycle_[victim].store(cycle, std::memory_order_relaxed);
-  worst_time_[victim].store(time_ns, std::memory_order_relaxed);
+  worst_value_[victim].store(v, std::memory_order_release);
+  worst_cycle_[victim].store(cycle, std::memory_order_release);
+  worst_time_[victim].store(time_ns, std::memory_order_release);
   worst_seq_.store(s + 2, std::memory_order_release);
   std::uint64_t floor = worst_value_[0].load(std::memory_order_relaxed);
   for (std::size_t i = 1; i < kWorst; ++i) floor = std::min(floor, worst_value_[i].load(std::memory_order_relaxed));
@@ -94,11 +94,10 @@ HistogramSnapshot Histogram::snapshot() const {
     if (before & 1) continue;
     std::vector<Outlier> w;
     for (std::size_t i = 0; i < kWorst; ++i) {
-      Outlier o{worst_value_[i].load(std::memory_order_relaxed), worst_cycle_[i].load(std::memory_order_relaxed),
-                worst_time_[i].load(std::memory_order_relaxed)};
+      Outlier o{worst_value_[i].load(std::memory_order_acquire), worst_cycle_[i].load(std::memory_order_acquire),
+                worst_time_[i].load(std::memory_order_acquire)};
       if (o.value_ns != 0 || o.time_ns != 0) w.push_back(o);
     }
-    std::atomic_thread_fence(std::memory_order_acquire);
     if (worst_seq_.load(std::memory_order_relaxed) != before) continue;
     std::sort(w.begin(), w.end(), [](const Outlier& a, const Outlier& b) { return a.value_ns > b.value_ns; });
     s.worst = std::move(w);

@@ -14,21 +14,22 @@ void LatestChannel::write(const void* data, std::int64_t stamp_ns) noexcept {
   const std::uint64_t version = latest_.load(std::memory_order_relaxed) + 1;
   const std::size_t slot = version % kSlots;
   SlotHeader& h = header(slot);
+  // Seqlock without fences (Boehm 2012): the payload stores are release stores, so the odd
+  // sequence store before them cannot sink below them; on x86-64 they are plain moves.
   h.seq.store(2 * version - 1, std::memory_order_relaxed);  // odd: being written
-  std::atomic_thread_fence(std::memory_order_release);
-  h.stamp_ns.store(stamp_ns, std::memory_order_relaxed);
+  h.stamp_ns.store(stamp_ns, std::memory_order_release);
   Word* dst = words(slot);
   const auto* src = static_cast<const unsigned char*>(data);
   const std::size_t full = size_ / 8;
   for (std::size_t w = 0; w < full; ++w) {
     std::uint64_t v;
     std::memcpy(&v, src + 8 * w, 8);
-    dst[w].store(v, std::memory_order_relaxed);
+    dst[w].store(v, std::memory_order_release);
   }
   if (const std::size_t tail = size_ - 8 * full; tail != 0) {
     std::uint64_t v = 0;
     std::memcpy(&v, src + 8 * full, tail);
-    dst[full].store(v, std::memory_order_relaxed);
+    dst[full].store(v, std::memory_order_release);
   }
   h.seq.store(2 * version, std::memory_order_release);  // even: stable
   latest_.store(version, std::memory_order_release);
@@ -47,18 +48,18 @@ ReadInfo LatestChannel::read(void* out, std::uint64_t last_seen_seq) const noexc
     const SlotHeader& h = header(slot);
     const std::uint64_t before = h.seq.load(std::memory_order_acquire);
     if (before != 2 * version) continue;  // already being overwritten: take the newer one
-    const std::int64_t stamp = h.stamp_ns.load(std::memory_order_relaxed);
+    // Acquire loads of the payload keep the closing sequence load after them.
+    const std::int64_t stamp = h.stamp_ns.load(std::memory_order_acquire);
     const Word* src = words(slot);
     const std::size_t full = size_ / 8;
     for (std::size_t w = 0; w < full; ++w) {
-      const std::uint64_t v = src[w].load(std::memory_order_relaxed);
+      const std::uint64_t v = src[w].load(std::memory_order_acquire);
       std::memcpy(dst + 8 * w, &v, 8);
     }
     if (const std::size_t tail = size_ - 8 * full; tail != 0) {
-      const std::uint64_t v = src[full].load(std::memory_order_relaxed);
+      const std::uint64_t v = src[full].load(std::memory_order_acquire);
       std::memcpy(dst + 8 * full, &v, tail);
     }
-    std::atomic_thread_fence(std::memory_order_acquire);
     if (h.seq.load(std::memory_order_relaxed) == before) {
       return ReadInfo{Flow::new_data, version, stamp};
     }

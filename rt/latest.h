@@ -4,8 +4,9 @@
 // publishes its sequence number: write is wait-free. A reader copies the newest slot and checks
 // that the slot's sequence did not change while it copied; it retries (at most kMaxReadTries
 // times) only if the writer lapped the whole ring during one copy, so reads are wait-free in
-// practice and bounded always. Payload words are copied with relaxed atomics so that the race a
-// seqlock tolerates by design is not undefined behaviour (and ThreadSanitizer agrees).
+// practice and bounded always. Payload words are copied with release stores and acquire loads
+// (plain moves on x86-64) so that the race a seqlock tolerates by design is not undefined
+// behaviour, needs no fence, and ThreadSanitizer agrees.
 // The channel is type-erased (bytes) so that it outlives the plugin library that wrote it.
 #pragma once
 

@@ -1,0 +1,84 @@
+#include "core/daemon/report_builder.h"
+
+#include <algorithm>
+#include <ctime>
+
+#include "core/report/from_rt.h"
+#include "rt/clock.h"
+
+namespace crease::daemon {
+
+namespace {
+std::string iso_now() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+const char* event_kind(HostEvent::Type t) {
+  switch (t) {
+    case HostEvent::Type::loaded: return "load";
+    case HostEvent::Type::unloaded: return "unload";
+    case HostEvent::Type::swapped: return "hot_swap";
+    case HostEvent::Type::swap_state_lost: return "hot_swap";
+    case HostEvent::Type::fault: return "fault";
+    case HostEvent::Type::activated: return "activate";
+    case HostEvent::Type::deactivated: return "deactivate";
+  }
+  return "event";
+}
+}  // namespace
+
+report::TimingReport build_report(const PluginHost& host, const RunFacts& facts) {
+  report::TimingReport r;
+  r.config_file = facts.config_file;
+  r.start_ns = facts.start_ns;
+  r.end_ns = rt::now_ns();
+  r.wall_clock = iso_now();
+  r.machine = report::probe_machine();
+  r.machine.mlockall_applied = facts.mlockall_applied;
+  r.machine.affinity_applied = facts.affinity_applied;
+  r.machine.sched_fifo_applied = facts.sched_fifo_applied;
+
+  const auto instances = host.instances();
+  for (const Loop* loop : host.loops()) {
+    report::LoopTiming lt;
+    const LoopSpec& spec = loop->spec();
+    lt.name = spec.name;
+    lt.rate_hz = spec.rate_hz;
+    lt.priority = spec.priority;
+    lt.cpu = spec.cpu;
+    const rt::LoopTiming& t = loop->timing();
+    lt.cycles = t.cycles.load();
+    lt.overruns = t.missed_periods.load();
+    lt.missed_deadlines = t.overruns.load();
+    lt.wakeup_latency = report::from_snapshot(t.wakeup_latency.snapshot());
+    lt.execution = report::from_snapshot(t.execution.snapshot());
+    std::vector<const InstanceInfo*> mine;
+    for (const InstanceInfo& i : instances) {
+      if (i.loop == spec.name) mine.push_back(&i);
+    }
+    std::stable_sort(mine.begin(), mine.end(), [](auto* a, auto* b) { return a->order < b->order; });
+    {
+      for (const InstanceInfo* ip : mine) {
+        const InstanceInfo& i = *ip;
+        report::PluginTiming pt;
+        pt.name = i.name;
+        pt.library = i.plugin + " " + i.version;
+        pt.state = to_string(i.state);
+        pt.execution = report::from_snapshot(i.stats->execution.snapshot());
+        pt.faults = i.stats->faults.load();
+        pt.swaps = i.stats->swaps.load();
+        lt.plugins.push_back(std::move(pt));
+      }
+    }
+    r.loops.push_back(std::move(lt));
+  }
+  for (const HostEvent& e : host.events()) {
+    r.events.push_back({e.time_ns, event_kind(e.type), e.loop, e.instance, e.detail});
+  }
+  return r;
+}
+
+}  // namespace crease::daemon

@@ -1,0 +1,22 @@
+// Builds the timing report (core/report) from the running host: loops, plugins, events.
+// Non-RT; reads the RT histograms through snapshots.
+#pragma once
+
+#include <string>
+
+#include "core/plugin_host.h"
+#include "core/report/timing_report.h"
+
+namespace crease::daemon {
+
+struct RunFacts {
+  std::string config_file;
+  std::int64_t start_ns = 0;
+  bool mlockall_applied = false;
+  bool affinity_applied = false;
+  bool sched_fifo_applied = false;
+};
+
+[[nodiscard]] report::TimingReport build_report(const PluginHost& host, const RunFacts& facts);
+
+}  // namespace crease::daemon

@@ -1,0 +1,131 @@
+// crease-bench jitter [--seconds N] [--priority P] [--background-ms M]: wake-up latency of a
+// Crease 1 kHz loop next to a busy background loop (15 Hz, burning M ms of CPU per cycle, like a
+// vision loop), then, in the same invocation and with the same background, cyclictest with the
+// same period and priority. Prints both distributions and their ratios.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_registry.h"
+#include "bench_util.h"
+#include "core/plugin_host.h"
+#include "rt/rt_setup.h"
+
+namespace {
+struct Dist {
+  double p50_us = 0, p99_us = 0, p999_us = 0, max_us = 0;
+  std::uint64_t samples = 0;
+};
+
+// Percentiles from cyclictest's -h histogram (one line "%06d %06lu" per microsecond).
+bool run_cyclictest(int priority, double seconds, Dist& d, std::string& why) {
+  const long loops = std::lround(seconds * 1000.0);
+  const std::string cmd = "cyclictest -m -q -p " + std::to_string(priority) + " -i 1000 -l " + std::to_string(loops) +
+                          " -h 20000 2>&1";
+  FILE* f = popen(cmd.c_str(), "r");
+  if (f == nullptr) {
+    why = "cannot run cyclictest";
+    return false;
+  }
+  std::vector<std::uint64_t> hist(20001, 0);
+  std::uint64_t overflow = 0;
+  double max_us = 0;
+  char line[512];
+  std::string text;
+  while (std::fgets(line, sizeof(line), f) != nullptr) {
+    text += line;
+    unsigned long us = 0, count = 0;
+    if (line[0] != '#' && std::sscanf(line, "%lu %lu", &us, &count) == 2 && us < hist.size()) hist[us] += count;
+    if (std::sscanf(line, "# Histogram Overflows: %lu", &count) == 1) overflow += count;
+    if (std::sscanf(line, "# Max Latencies: %lu", &us) == 1) max_us = double(us);
+  }
+  const int rc = pclose(f);
+  std::uint64_t total = overflow;
+  for (auto c : hist) total += c;
+  if (rc != 0 || total == 0) {
+    why = "cyclictest failed (exit " + std::to_string(rc) + "): " + text.substr(0, 300);
+    return false;
+  }
+  auto pct = [&](double p) {
+    const auto rank = static_cast<std::uint64_t>(std::ceil(p / 100.0 * double(total)));
+    std::uint64_t seen = 0;
+    for (std::size_t us = 0; us < hist.size(); ++us) {
+      seen += hist[us];
+      if (seen >= rank) return double(us);
+    }
+    return max_us;
+  };
+  d = {pct(50), pct(99), pct(99.9), max_us, total};
+  return true;
+}
+
+crease::InstanceSpec instance(const std::string& name, const std::string& lib, const std::string& loop,
+                              const std::string& yaml) {
+  crease::InstanceSpec s;
+  s.name = name;
+  s.library = lib;
+  s.loop = loop;
+  s.params = crease::Params(YAML::Load(yaml), "bench", name);
+  s.ports = {{"out", name + "_out"}};
+  return s;
+}
+
+int run(int argc, char** argv) {
+  const double seconds = crease::bench::arg_double(argc, argv, "--seconds", 20);
+  const int priority = static_cast<int>(crease::bench::arg_double(argc, argv, "--priority", 80));
+  const double background_ms = crease::bench::arg_double(argc, argv, "--background-ms", 50);
+
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"control", 1000.0, priority, -1});
+  host.add_loop({"vision", 15.0, 0, -1});
+  host.add_instance(instance("noop", "crease_test_noop", "control", "{}"));
+  host.add_instance(instance("burn", "crease_test_slow", "vision",
+                             "{busy_us: " + std::to_string(std::lround(background_ms * 1000)) + "}"));
+  const auto mem = crease::rt::lock_memory(64u << 20);
+  std::printf("jitter: %s: %s %s\n", mem.what.c_str(), mem.applied ? "applied" : "not applied:", mem.why.c_str());
+  for (const auto& s : host.start()) {
+    std::printf("jitter: %s: %s %s\n", s.what.c_str(), s.applied ? "applied" : "not applied:", s.why.c_str());
+  }
+  std::printf("jitter: phase 1: Crease 1 kHz loop, priority %d, with a 15 Hz loop burning %.0f ms per cycle, %.0f s\n",
+              priority, background_ms, seconds);
+  const crease::Loop* control = host.loops()[0];
+  const auto warm = control->timing().cycles.load();
+  (void)warm;
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  const auto lat = control->timing().wakeup_latency.snapshot();
+  const auto overruns = control->timing().overruns.load();
+  const auto cycles = control->timing().cycles.load();
+  // Phase 2: keep the background loop, stop ours, run cyclictest.
+  host.deactivate("noop");
+  std::printf("jitter: phase 2: cyclictest -m -p %d -i 1000 with the same background, %.0f s\n", priority, seconds);
+  Dist ct;
+  std::string why;
+  const bool have_ct = run_cyclictest(priority, seconds, ct, why);
+  host.stop();
+
+  const Dist ours{lat.percentile(50) / 1e3, lat.percentile(99) / 1e3, lat.percentile(99.9) / 1e3,
+                  double(lat.max_ns) / 1e3, lat.count};
+  std::printf("\n  wake-up latency (us)   %10s %10s %10s %10s %10s\n", "p50", "p99", "p99.9", "max", "samples");
+  std::printf("  crease loop            %10.1f %10.1f %10.1f %10.1f %10llu\n", ours.p50_us, ours.p99_us, ours.p999_us,
+              ours.max_us, (unsigned long long)ours.samples);
+  if (!have_ct) {
+    std::printf("  cyclictest             not available: %s\n", why.c_str());
+    std::printf("jitter: p99_ratio=nan p999_ratio=nan overruns=%llu cycles=%llu\n", (unsigned long long)overruns,
+                (unsigned long long)cycles);
+    return 1;
+  }
+  std::printf("  cyclictest             %10.1f %10.1f %10.1f %10.1f %10llu\n", ct.p50_us, ct.p99_us, ct.p999_us,
+              ct.max_us, (unsigned long long)ct.samples);
+  // cyclictest reports whole microseconds: compare against at least 1 us.
+  const double p99_ratio = ours.p99_us / std::max(ct.p99_us, 1.0);
+  const double p999_ratio = ours.p999_us / std::max(ct.p999_us, 1.0);
+  std::printf("  ratio (crease / cyclictest): p99 %.2f, p99.9 %.2f (target <= 1.10)\n", p99_ratio, p999_ratio);
+  std::printf("jitter: p99_ratio=%.2f p999_ratio=%.2f overruns=%llu cycles=%llu\n", p99_ratio, p999_ratio,
+              (unsigned long long)overruns, (unsigned long long)cycles);
+  return 0;
+}
+}  // namespace
+
+CREASE_BENCH(jitter, "1 kHz loop wake-up latency beside cyclictest, with a busy 15 Hz loop", run);
