@@ -49,8 +49,13 @@ function(crease_test name)
 endfunction()
 
 # Targets `tests-unit`, `tests-concurrency`, ... build just the executables of one label,
-# so the sanitizer builds compile only what they run.
+# so the sanitizer builds compile only what they run. `crease_all_plugins` builds every plugin.
 function(crease_finish_test_targets)
+  get_property(plugins GLOBAL PROPERTY CREASE_ALL_PLUGINS)
+  add_custom_target(crease_all_plugins)
+  if(plugins)
+    add_dependencies(crease_all_plugins ${plugins})
+  endif()
   foreach(label unit hil slow concurrency)
     get_property(exes GLOBAL PROPERTY CREASE_TESTS_${label})
     add_custom_target(tests-${label})

@@ -1,0 +1,186 @@
+// End to end: creased runs a test configuration; creasectl swaps a plugin while it runs, sets a
+// parameter, reads reports in every format and stops it. Bad configurations exit 2 before
+// anything starts (no socket, no report).
+#include <doctest/doctest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "core/control/control_client.h"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+const std::string kBin = CREASE_BIN_DIR;
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    char tmpl[] = "/tmp/crease-e2e-XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+std::string config_text(const std::string& extra_plugin = "") {
+  return std::string("plugin_dirs: [") + CREASE_PLUGIN_DIR + "]\n"
+         "loops:\n"
+         "  - {name: control, rate_hz: 1000, priority: 0}\n"
+         "plugins:\n"
+         "  - name: counter\n"
+         "    library: crease_test_counter_v1\n"
+         "    loop: control\n"
+         "    order: 1\n" +
+         extra_plugin;
+}
+
+struct Run {
+  int status = -1;
+  std::string out;
+};
+
+// Runs a shell command, returns its exit status and output (stdout + stderr).
+Run sh(const std::string& cmd) {
+  Run r;
+  FILE* f = popen((cmd + " 2>&1").c_str(), "r");
+  REQUIRE(f != nullptr);
+  char buf[4096];
+  while (std::fgets(buf, sizeof(buf), f) != nullptr) r.out += buf;
+  const int rc = pclose(f);
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  return r;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+TEST_CASE("creased runs, creasectl steers it, reports come out in every format") {
+  TempDir tmp;
+  const fs::path cfg = tmp.path / "test.yaml";
+  std::ofstream(cfg) << config_text();
+  const std::string sock = (tmp.path / "creased.sock").string();
+  const fs::path reports = tmp.path / "reports";
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const std::string out = (tmp.path / "creased.log").string();
+    std::freopen(out.c_str(), "w", stdout);
+    std::freopen(out.c_str(), "a", stderr);
+    execl((kBin + "/creased").c_str(), "creased", "--config", cfg.c_str(), "--socket", sock.c_str(), "--report-dir",
+          reports.c_str(), "--duration", "60", "--no-progress", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  bool up = false;
+  for (int i = 0; i < 200 && !up; ++i) {
+    std::this_thread::sleep_for(25ms);
+    up = fs::exists(sock);
+  }
+  REQUIRE(up);
+  struct stat st {};
+  REQUIRE(::stat(sock.c_str(), &st) == 0);
+  CHECK((st.st_mode & 0777) == 0600);
+
+  const std::string ctl = kBin + "/creasectl --socket " + sock + " ";
+  auto status = sh(ctl + "status");
+  CHECK(status.status == 0);
+
+  // Swap while running; the count carries on in the new version.
+  auto swap = sh(ctl + "swap counter crease_test_counter_v2");
+  CHECK(swap.status == 0);
+  auto plugins = sh(ctl + "--json plugins");
+  CHECK(nlohmann::json::parse(plugins.out)["result"][0]["version"] == "2.0.0");
+  // A refused swap leaves the running version alone and exits non-zero with the reason.
+  auto bad_swap = sh(ctl + "swap counter crease_test_wrong_abi");
+  CHECK(bad_swap.status != 0);
+  CHECK(bad_swap.out.find("ABI") != std::string::npos);
+
+  // Parameters: accepted, refused by range, refused by the plugin.
+  CHECK(sh(ctl + "param set counter increment 3").status == 0);
+  auto get = sh(ctl + "--json param get counter increment");
+  CHECK(nlohmann::json::parse(get.out)["result"]["value"] == 3.0);
+  CHECK(sh(ctl + "param set counter increment 500").status != 0);
+  CHECK(sh(ctl + "param set counter increment 13").status != 0);
+
+  {
+    crease::control::ControlClient client(sock);
+    const auto r = client.request({{"cmd", "ports"}});
+    CHECK(r["ok"] == true);
+    bool saw_count = false;
+    for (const auto& p : r["result"]) saw_count |= p["name"] == "count" && p["writes"].get<std::uint64_t>() > 0;
+    CHECK(saw_count);
+  }
+
+  for (const char* fmt : {"html", "json", "text"}) {
+    CAPTURE(fmt);
+    const fs::path out = tmp.path / (std::string("live.") + fmt);
+    auto rep = sh(ctl + "report --format " + fmt + " --out " + out.string());
+    CHECK(rep.status == 0);
+    const std::string body = slurp(out);
+    CHECK(body.size() > 100);
+    CHECK(body.find("control") != std::string::npos);
+  }
+  CHECK(slurp(tmp.path / "live.html").find("<svg") != std::string::npos);
+  CHECK(slurp(tmp.path / "live.text").find("# Histogram") != std::string::npos);
+
+  CHECK(sh(ctl + "stop").status == 0);
+  int wstatus = 0;
+  for (int i = 0; i < 200; ++i) {
+    if (waitpid(pid, &wstatus, WNOHANG) == pid) break;
+    std::this_thread::sleep_for(25ms);
+  }
+  REQUIRE(WIFEXITED(wstatus));
+  CHECK(WEXITSTATUS(wstatus) == 0);
+  CHECK_FALSE(fs::exists(sock));
+  for (const char* f : {"report.html", "report.json", "report.txt"}) CHECK(fs::exists(reports / f));
+  const std::string json = slurp(reports / "report.json");
+  CHECK(json.find("hot_swap") != std::string::npos);
+  const std::string log = slurp(tmp.path / "creased.log");
+  CHECK(log.find("creasectl stop") != std::string::npos);
+
+  // After it stopped, creasectl says so and exits non-zero.
+  auto gone = sh(ctl + "status");
+  CHECK(gone.status != 0);
+}
+
+TEST_CASE("bad configurations exit 2 with file, line and key, and start nothing") {
+  TempDir tmp;
+  struct Case {
+    std::string text;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {config_text("    params: {increment: 500}\n"), "test.yaml:9:25: plugins[0].params.increment: must be in [0, 100], got 500"},
+      {config_text("    params: {incremnt: 5}\n"), "plugins[0].params.incremnt: unknown parameter"},
+      {config_text("    ports: {cuont: x}\n"), "ports.cuont: the plugin has no port 'cuont'"},
+      {config_text("  - {name: wrong, library: crease_test_wrong_abi, loop: control, order: 2}\n"),
+       "plugins[1] 'wrong': plugin library"},
+      {config_text("  - {name: other, library: crease_test_counter_v2, loop: control, order: 2}\n"),
+       "port 'count': instance 'other' cannot write it: instance 'counter' already does"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.text);
+    const fs::path cfg = tmp.path / "test.yaml";
+    std::ofstream(cfg) << c.text;
+    const std::string sock = (tmp.path / "s.sock").string();
+    auto r = sh(kBin + "/creased --config " + cfg.string() + " --socket " + sock + " --report-dir " +
+                (tmp.path / "rep").string() + " --duration 5");
+    CHECK(r.status == 2);
+    CHECK(r.out.find(c.expect) != std::string::npos);
+    CHECK_FALSE(fs::exists(sock));
+    CHECK_FALSE(fs::exists(tmp.path / "rep"));
+  }
+}
