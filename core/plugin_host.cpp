@@ -119,7 +119,12 @@ void PluginHost::add_instance(const InstanceSpec& spec) {
 std::vector<rt::SetupStep> PluginHost::start() {
   std::lock_guard lock(mu_);
   std::vector<rt::SetupStep> steps;
-  for (auto& l : loops_) {
+  // Lowest priority first: thread creation and stack prefault (mmap work) of the others is
+  // over before the most demanding loop takes its first deadline.
+  std::vector<Loop*> order;
+  for (auto& l : loops_) order.push_back(l.get());
+  std::stable_sort(order.begin(), order.end(), [](Loop* a, Loop* b) { return a->spec().priority < b->spec().priority; });
+  for (Loop* l : order) {
     for (rt::SetupStep& s : l->start()) steps.push_back(std::move(s));
   }
   running_ = true;

@@ -87,6 +87,7 @@ int Daemon::run() {
   so.socket_path = options_.socket ? *options_.socket : d.socket ? *d.socket : control::default_socket_path();
   so.socket_group = d.socket_group;
   server_ = std::make_unique<control::ControlServer>(so, *this);
+  server_->start();  // before the loops: its threads' creation is done when they take deadlines
 
   facts_.config_file = config_.file;
   facts_.start_ns = rt::now_ns();
@@ -105,7 +106,6 @@ int Daemon::run() {
   }
   facts_.sched_fifo_applied &= any_fifo;
   facts_.affinity_applied &= any_cpu;
-  server_->start();
   spdlog::info("creased running: {} loops, {} plugins, control socket {}", config_.loops.size(), config_.plugins.size(),
                server_->socket_path());
   sd_notify(0, "READY=1");
