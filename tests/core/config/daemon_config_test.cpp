@@ -1,0 +1,250 @@
+// Tests for core/config/daemon_config.h: a good file, then many bad ones, each with the exact
+// message (file, 1-based line and column, key path, reason) the user will read.
+#include "core/config/daemon_config.h"
+
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+namespace cfg = crease::config;
+
+namespace {
+
+const cfg::LoadOptions kNoDirCheck{false};
+
+std::string error_of(const std::string& text, const cfg::LoadOptions& options = kNoDirCheck) {
+  try {
+    (void)cfg::load_daemon_config_from_string(text, "/etc/crease/bad.yaml", options);
+  } catch (const cfg::ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const char* const kGood = R"(plugin_dirs: [../plugins-lib, /opt/crease/plugins]
+daemon:
+  socket: run/creased.sock
+  socket_group: crease
+  report_dir: reports
+  duration_s: 30
+  lock_memory: false
+  prefault_heap_mb: 16
+  cpu_dma_latency_us: 0
+loops:
+  - name: control
+    rate_hz: 1000
+    priority: 80
+    cpu: 1
+    overrun: skip
+  - name: model
+    rate_hz: 60
+    priority: 0
+plugins:
+  - name: second
+    library: crease_counter
+    loop: control
+    order: 20
+    params: {step: 2, nested: {a: [1, 2]}}
+    ports: {out: counter_b}
+  - name: first
+    library: ./libs/libcustom.so
+    loop: control
+    order: 10
+    enabled: false
+  - name: modeller
+    library: crease_counter
+    loop: model
+    order: 10
+safety:
+  on_fault: stop
+  max_overruns_per_s: 5
+)";
+
+}  // namespace
+
+TEST_CASE("a complete configuration loads into plain structs with resolved paths and marks") {
+  const cfg::DaemonConfig c =
+      cfg::load_daemon_config_from_string(kGood, "/etc/crease/sim.yaml", kNoDirCheck);
+  CHECK(c.file == "/etc/crease/sim.yaml");
+  REQUIRE(c.plugin_dirs.size() == 2);
+  CHECK(c.plugin_dirs[0] == "/etc/plugins-lib");
+  CHECK(c.plugin_dirs[1] == "/opt/crease/plugins");
+  CHECK(c.daemon.socket.value() == "/etc/crease/run/creased.sock");
+  CHECK(c.daemon.socket_group.value() == "crease");
+  CHECK(c.daemon.report_dir.value() == "/etc/crease/reports");
+  CHECK(c.daemon.duration_s.value() == doctest::Approx(30.0));
+  CHECK_FALSE(c.daemon.lock_memory);
+  CHECK(c.daemon.prefault_heap_mb == 16);
+  CHECK(c.daemon.cpu_dma_latency_us.value() == 0);
+
+  REQUIRE(c.loops.size() == 2);
+  CHECK(c.loops[0].name == "control");
+  CHECK(c.loops[0].rate_hz == doctest::Approx(1000.0));
+  CHECK(c.loops[0].period_ns() == 1000000);
+  CHECK(c.loops[0].priority == 80);
+  CHECK(c.loops[0].cpu == 1);
+  CHECK(c.loops[0].loc.line == 11);
+  CHECK(c.loops[0].loc.column == 5);
+  CHECK(c.loops[1].cpu == -1);
+  CHECK(c.loops[1].period_ns() == 16666667);
+
+  REQUIRE(c.plugins.size() == 3);
+  const cfg::PluginConfig* second = c.find_plugin("second");
+  REQUIRE(second != nullptr);
+  CHECK(second->library == "crease_counter");
+  CHECK(second->enabled);
+  CHECK(second->params["step"].as<int>() == 2);
+  CHECK(second->params["nested"]["a"][1].as<int>() == 2);
+  CHECK(second->params_loc.line == 24);
+  CHECK(second->ports.at("out") == "counter_b");
+  CHECK(second->loc.str() == "/etc/crease/sim.yaml:20:5");
+  CHECK(c.find_plugin("first")->library == "/etc/crease/libs/libcustom.so");
+  CHECK_FALSE(c.find_plugin("first")->enabled);
+  CHECK(c.find_plugin("modeller")->params.IsMap());
+  CHECK(c.find_plugin("nope") == nullptr);
+
+  const auto ordered = c.plugins_of_loop("control");
+  REQUIRE(ordered.size() == 2);
+  CHECK(ordered[0]->name == "first");
+  CHECK(ordered[1]->name == "second");
+  CHECK(c.safety.on_fault == cfg::FaultPolicy::stop);
+  CHECK(c.safety.max_overruns_per_s == doctest::Approx(5.0));
+}
+
+TEST_CASE("defaults: optional sections may be absent") {
+  const cfg::DaemonConfig c = cfg::load_daemon_config_from_string(
+      "plugin_dirs: [p]\nloops: [{name: a, rate_hz: 10, priority: 0}]\n", "x.yaml", kNoDirCheck);
+  CHECK(c.plugin_dirs[0] == "p");
+  CHECK_FALSE(c.daemon.socket.has_value());
+  CHECK_FALSE(c.daemon.duration_s.has_value());
+  CHECK_FALSE(c.daemon.cpu_dma_latency_us.has_value());
+  CHECK(c.daemon.lock_memory);
+  CHECK(c.plugins.empty());
+  CHECK(c.safety.on_fault == cfg::FaultPolicy::deactivate);
+  CHECK(c.safety.max_overruns_per_s == 0.0);
+}
+
+// Each bad file shares this head (lines 1-5); the cases append or replace lines.
+#define HEAD "plugin_dirs: [p]\nloops:\n  - name: control\n    rate_hz: 1000\n    priority: 80\n"
+
+TEST_CASE("bad configurations name file, line, column, key and reason") {
+  struct Case {
+    const char* what;
+    const char* text;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"unknown top-level key", HEAD "plugin: []\n",
+       "/etc/crease/bad.yaml:6:1: plugin: unknown key 'plugin' (did you mean 'plugins'?)"},
+      {"typo in a loop key", "plugin_dirs: [p]\nloops:\n  - name: control\n    rat_hz: 1000\n",
+       "/etc/crease/bad.yaml:4:5: loops[0].rat_hz: unknown key 'rat_hz' (did you mean 'rate_hz'?)"},
+      {"rate zero", "plugin_dirs: [p]\nloops:\n  - name: control\n    rate_hz: 0\n    priority: 1\n",
+       "/etc/crease/bad.yaml:4:14: loops[0].rate_hz: must be in (0, 20000], got 0"},
+      {"rate too high", "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: 30000, priority: 1}\n",
+       "/etc/crease/bad.yaml:3:24: loops[0].rate_hz: must be in (0, 20000], got 30000"},
+      {"priority out of range", "plugin_dirs: [p]\nloops:\n  - name: c\n    rate_hz: 10\n    priority: 120\n",
+       "/etc/crease/bad.yaml:5:15: loops[0].priority: must be in [0, 99], got 120"},
+      {"priority not an integer", "plugin_dirs: [p]\nloops:\n  - name: c\n    rate_hz: 10\n    priority: high\n",
+       "/etc/crease/bad.yaml:5:15: loops[0].priority: expected an integer, got 'high'"},
+      {"cpu out of range", HEAD "    cpu: 2048\n",
+       "/etc/crease/bad.yaml:6:10: loops[0].cpu: must be in [-1, 1023], got 2048"},
+      {"unknown overrun policy", HEAD "    overrun: catch_up\n",
+       "/etc/crease/bad.yaml:6:14: loops[0].overrun: unknown overrun policy 'catch_up' (only 'skip' is supported)"},
+      {"duplicate loop name", HEAD "  - name: control\n    rate_hz: 10\n    priority: 1\n",
+       "/etc/crease/bad.yaml:6:11: loops[1].name: duplicate loop name 'control' (first at /etc/crease/bad.yaml:3:5)"},
+      {"invalid loop name", "plugin_dirs: [p]\nloops:\n  - name: Control\n    rate_hz: 10\n    priority: 1\n",
+       "/etc/crease/bad.yaml:3:11: loops[0].name: 'Control' is not a valid name ([a-z][a-z0-9_]*)"},
+      {"plugin on an unknown loop",
+       HEAD "plugins:\n  - name: counter\n    library: crease_counter\n    loop: contrl\n    order: 1\n",
+       "/etc/crease/bad.yaml:9:11: plugins[0].loop: unknown loop 'contrl' (did you mean 'control'?)"},
+      {"order tie",
+       HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 5}\n"
+            "  - {name: b, library: x, loop: control, order: 5}\n",
+       "/etc/crease/bad.yaml:8:49: plugins[1].order: order 5 is already used by 'a' in loop 'control'"},
+      {"missing library", HEAD "plugins:\n  - name: a\n    loop: control\n    order: 1\n",
+       "/etc/crease/bad.yaml:7:5: plugins[0].library: required key is missing"},
+      {"params not a map", HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 1, params: [1, 2]}\n",
+       "/etc/crease/bad.yaml:7:60: plugins[0].params: expected a map"},
+      {"empty plugin_dirs", "plugin_dirs: []\nloops: [{name: a, rate_hz: 1, priority: 0}]\n",
+       "/etc/crease/bad.yaml:1:14: plugin_dirs: expected a non-empty list of folders"},
+      {"missing loops", "plugin_dirs: [p]\nplugins: []\n",
+       "/etc/crease/bad.yaml:1:1: loops: required key is missing"},
+      {"YAML syntax error", "plugin_dirs: [p\nloops: []\n",
+       "/etc/crease/bad.yaml:2:6: (syntax): end of sequence flow not found"},
+      {"unknown fault policy", HEAD "safety:\n  on_fault: explode\n",
+       "/etc/crease/bad.yaml:7:13: safety.on_fault: expected 'deactivate' or 'stop', got 'explode'"},
+      {"negative duration", HEAD "daemon:\n  duration_s: -1\n",
+       "/etc/crease/bad.yaml:7:15: daemon.duration_s: must be in (0, 1e+09], got -1"},
+      {"duplicate key", HEAD "    priority: 10\n",
+       "/etc/crease/bad.yaml:6:5: loops[0].priority: duplicate key 'priority'"},
+      {"enabled not a bool", HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 1, enabled: maybe}\n",
+       "/etc/crease/bad.yaml:7:61: plugins[0].enabled: expected true or false, got 'maybe'"},
+      {"duplicate plugin name",
+       HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 1}\n"
+            "  - {name: a, library: x, loop: control, order: 2}\n",
+       "/etc/crease/bad.yaml:8:12: plugins[1].name: duplicate plugin name 'a' (first at /etc/crease/bad.yaml:7:5)"},
+      {"top level is a list", "- a\n- b\n",
+       "/etc/crease/bad.yaml:1:1: (document): expected a map with plugin_dirs, loops and plugins"},
+      {"port map not a map", HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 1, ports: out}\n",
+       "/etc/crease/bad.yaml:7:59: plugins[0].ports: expected a map local: global"},
+      {"socket is a list", HEAD "daemon:\n  socket: [a]\n",
+       "/etc/crease/bad.yaml:7:11: daemon.socket: expected a string, got a list"},
+      {"nan rate", "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: .nan, priority: 1}\n",
+       "/etc/crease/bad.yaml:3:24: loops[0].rate_hz: expected a finite number, got '.nan'"},
+  };
+  static_assert(sizeof(cases) / sizeof(cases[0]) >= 15);
+  for (const Case& c : cases) {
+    CAPTURE(c.what);
+    CHECK(error_of(c.text) == c.expected);
+  }
+}
+
+TEST_CASE("plugin_dirs must exist when checked, resolved against the file's folder") {
+  const std::string dir = std::filesystem::temp_directory_path() /
+                          ("crease_cfg_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir + "/plugins");
+  const std::string file = dir + "/good.yaml";
+  {
+    std::ofstream out(file);
+    out << "plugin_dirs: [plugins, missing]\nloops: [{name: a, rate_hz: 1, priority: 0}]\n";
+  }
+  try {
+    (void)cfg::load_daemon_config(file);
+    FAIL("expected a ConfigError");
+  } catch (const cfg::ConfigError& e) {
+    CHECK(std::string(e.what()) == file + ":1:24: plugin_dirs[1]: '" + dir +
+                                       "/missing' is not a directory");
+    CHECK(e.loc().line == 1);
+    CHECK(e.key_path() == "plugin_dirs[1]");
+  }
+  {
+    std::ofstream out(file);
+    out << "plugin_dirs: [plugins]\nloops: [{name: a, rate_hz: 1, priority: 0}]\n";
+  }
+  const cfg::DaemonConfig c = cfg::load_daemon_config(file);
+  CHECK(c.plugin_dirs.at(0) == dir + "/plugins");
+  std::filesystem::remove_all(dir);
+
+  CHECK(error_of("", kNoDirCheck).find("(document)") != std::string::npos);
+  try {
+    (void)cfg::load_daemon_config(dir + "/does_not_exist.yaml");
+    FAIL("expected a ConfigError");
+  } catch (const cfg::ConfigError& e) {
+    CHECK(std::string(e.what()).find("cannot read") != std::string::npos);
+  }
+}
+
+TEST_CASE("error_at lets a plugin point into the config for a bad parameter") {
+  const cfg::DaemonConfig c = cfg::load_daemon_config_from_string(
+      HEAD "plugins:\n  - name: a\n    library: x\n    loop: control\n    order: 1\n"
+           "    params:\n      gain: -3\n",
+      "sim.yaml", kNoDirCheck);
+  const auto& p = c.plugins.at(0);
+  const cfg::ConfigError e =
+      cfg::error_at(c.file, p.params["gain"], "plugins[0].params.gain", "must be positive");
+  CHECK(std::string(e.what()) == "sim.yaml:12:13: plugins[0].params.gain: must be positive");
+}
