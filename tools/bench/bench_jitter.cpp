@@ -2,6 +2,7 @@
 // Crease 1 kHz loop next to a busy background loop (15 Hz, burning M ms of CPU per cycle, like a
 // vision loop), then, in the same invocation and with the same background, cyclictest with the
 // same period and priority. Prints both distributions and their ratios.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -19,8 +20,9 @@ struct Dist {
   std::uint64_t samples = 0;
 };
 
-// Percentiles from cyclictest's -h histogram (one line "%06d %06lu" per microsecond).
-bool run_cyclictest(int priority, double seconds, Dist& d, std::string& why) {
+// Runs cyclictest for `seconds` and adds its -h histogram (one line "%06d %06lu" per
+// microsecond; overflows counted in the last slot) into `hist`.
+bool run_cyclictest(int priority, double seconds, std::vector<std::uint64_t>& hist, std::string& why) {
   const long loops = std::lround(seconds * 1000.0);
   const std::string cmd = "cyclictest -m -q -p " + std::to_string(priority) + " -i 1000 -l " + std::to_string(loops) +
                           " -h 20000 2>&1";
@@ -29,24 +31,36 @@ bool run_cyclictest(int priority, double seconds, Dist& d, std::string& why) {
     why = "cannot run cyclictest";
     return false;
   }
-  std::vector<std::uint64_t> hist(20001, 0);
-  std::uint64_t overflow = 0;
-  double max_us = 0;
+  hist.resize(20002, 0);
   char line[512];
   std::string text;
+  std::uint64_t added = 0;
   while (std::fgets(line, sizeof(line), f) != nullptr) {
-    text += line;
+    if (text.size() < 2000) text += line;
     unsigned long us = 0, count = 0;
-    if (line[0] != '#' && std::sscanf(line, "%lu %lu", &us, &count) == 2 && us < hist.size()) hist[us] += count;
-    if (std::sscanf(line, "# Histogram Overflows: %lu", &count) == 1) overflow += count;
-    if (std::sscanf(line, "# Max Latencies: %lu", &us) == 1) max_us = double(us);
+    if (line[0] != '#' && std::sscanf(line, "%lu %lu", &us, &count) == 2 && us < 20001) {
+      hist[us] += count;
+      added += count;
+    }
+    if (std::sscanf(line, "# Histogram Overflows: %lu", &count) == 1) {
+      hist[20001] += count;
+      added += count;
+    }
   }
   const int rc = pclose(f);
-  std::uint64_t total = overflow;
-  for (auto c : hist) total += c;
-  if (rc != 0 || total == 0) {
+  if (rc != 0 || added == 0) {
     why = "cyclictest failed (exit " + std::to_string(rc) + "): " + text.substr(0, 300);
     return false;
+  }
+  return true;
+}
+
+Dist percentiles_of(const std::vector<std::uint64_t>& hist) {
+  std::uint64_t total = 0;
+  double max_us = 0;
+  for (std::size_t us = 0; us < hist.size(); ++us) {
+    total += hist[us];
+    if (hist[us] > 0) max_us = double(us);
   }
   auto pct = [&](double p) {
     const auto rank = static_cast<std::uint64_t>(std::ceil(p / 100.0 * double(total)));
@@ -57,8 +71,7 @@ bool run_cyclictest(int priority, double seconds, Dist& d, std::string& why) {
     }
     return max_us;
   };
-  d = {pct(50), pct(99), pct(99.9), max_us, total};
-  return true;
+  return Dist{pct(50), pct(99), pct(99.9), max_us, total};
 }
 
 crease::InstanceSpec instance(const std::string& name, const std::string& lib, const std::string& loop,
@@ -72,41 +85,64 @@ crease::InstanceSpec instance(const std::string& name, const std::string& lib, c
   return s;
 }
 
+// Adds the samples of `s` into `into` (same bucket layout).
+void accumulate(crease::rt::HistogramSnapshot& into, const crease::rt::HistogramSnapshot& s) {
+  if (into.counts.empty()) into.counts.assign(s.counts.size(), 0);
+  for (std::size_t b = 0; b < s.counts.size(); ++b) into.counts[b] += s.counts[b];
+  into.count += s.count;
+  into.max_ns = std::max(into.max_ns, s.max_ns);
+}
+
 int run(int argc, char** argv) {
   const double seconds = crease::bench::arg_double(argc, argv, "--seconds", 20);
   const int priority = static_cast<int>(crease::bench::arg_double(argc, argv, "--priority", 80));
   const double background_ms = crease::bench::arg_double(argc, argv, "--background-ms", 50);
+  // Crease and cyclictest take turns in chunks, so both meet the same machine noise.
+  const int chunks = std::max(1, static_cast<int>(crease::bench::arg_double(argc, argv, "--chunks", 4)));
+  const double chunk_s = seconds / chunks;
 
-  crease::PluginHost host({CREASE_PLUGIN_DIR});
-  host.add_loop({"control", 1000.0, priority, -1});
-  host.add_loop({"vision", 15.0, 0, -1});
-  host.add_instance(instance("noop", "crease_test_noop", "control", "{}"));
-  host.add_instance(instance("burn", "crease_test_slow", "vision",
-                             "{busy_us: " + std::to_string(std::lround(background_ms * 1000)) + "}"));
   const auto mem = crease::rt::lock_memory(64u << 20);
   std::printf("jitter: %s: %s %s\n", mem.what.c_str(), mem.applied ? "applied" : "not applied:", mem.why.c_str());
-  for (const auto& s : host.start()) {
-    std::printf("jitter: %s: %s %s\n", s.what.c_str(), s.applied ? "applied" : "not applied:", s.why.c_str());
-  }
-  std::printf("jitter: phase 1: Crease 1 kHz loop, priority %d, with a 15 Hz loop burning %.0f ms per cycle, %.0f s\n",
-              priority, background_ms, seconds);
-  const crease::Loop* control = host.loops()[0];
-  const auto warm = control->timing().cycles.load();
-  (void)warm;
-  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
-  const auto lat = control->timing().wakeup_latency.snapshot();
-  const auto overruns = control->timing().overruns.load();
-  const auto cycles = control->timing().cycles.load();
-  // Phase 2: keep the background loop, stop ours, run cyclictest.
-  host.deactivate("noop");
-  std::printf("jitter: phase 2: cyclictest -m -p %d -i 1000 with the same background, %.0f s\n", priority, seconds);
-  Dist ct;
-  std::string why;
-  const bool have_ct = run_cyclictest(priority, seconds, ct, why);
-  host.stop();
+  crease::PluginHost background({CREASE_PLUGIN_DIR});
+  background.add_loop({"vision", 15.0, 0, -1});
+  background.add_instance(instance("burn", "crease_test_slow", "vision",
+                                   "{busy_us: " + std::to_string(std::lround(background_ms * 1000)) + "}"));
+  background.start();
+  std::printf("jitter: background: a 15 Hz loop burning %.0f ms per cycle; %d turns of %.1f s each for Crease "
+              "(1 kHz, priority %d) and cyclictest (-m -p %d -i 1000)\n",
+              background_ms, chunks, chunk_s, priority, priority);
 
-  const Dist ours{lat.percentile(50) / 1e3, lat.percentile(99) / 1e3, lat.percentile(99.9) / 1e3,
-                  double(lat.max_ns) / 1e3, lat.count};
+  crease::rt::HistogramSnapshot ours_hist;
+  std::uint64_t overruns = 0, cycles = 0;
+  Dist ct_total;
+  std::vector<Dist> ct_chunks;
+  std::string why;
+  bool have_ct = true;
+  std::vector<std::uint64_t> ct_hist;
+  for (int c = 0; c < chunks; ++c) {
+    {
+      crease::PluginHost host({CREASE_PLUGIN_DIR});
+      host.add_loop({"control", 1000.0, priority, -1});
+      host.add_instance(instance("noop", "crease_test_noop", "control", "{}"));
+      const auto steps = host.start();
+      if (c == 0) {
+        for (const auto& st : steps) {
+          std::printf("jitter: %s: %s %s\n", st.what.c_str(), st.applied ? "applied" : "not applied:", st.why.c_str());
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::duration<double>(chunk_s));
+      const crease::Loop* control = host.loops()[0];
+      accumulate(ours_hist, control->timing().wakeup_latency.snapshot());
+      overruns += control->timing().overruns.load();
+      cycles += control->timing().cycles.load();
+      host.stop();
+    }
+    if (have_ct) have_ct = run_cyclictest(priority, chunk_s, ct_hist, why);
+  }
+  background.stop();
+
+  const Dist ours{double(ours_hist.percentile(50)) / 1e3, double(ours_hist.percentile(99)) / 1e3,
+                  double(ours_hist.percentile(99.9)) / 1e3, double(ours_hist.max_ns) / 1e3, ours_hist.count};
   std::printf("\n  wake-up latency (us)   %10s %10s %10s %10s %10s\n", "p50", "p99", "p99.9", "max", "samples");
   std::printf("  crease loop            %10.1f %10.1f %10.1f %10.1f %10llu\n", ours.p50_us, ours.p99_us, ours.p999_us,
               ours.max_us, (unsigned long long)ours.samples);
@@ -116,6 +152,7 @@ int run(int argc, char** argv) {
                 (unsigned long long)cycles);
     return 1;
   }
+  const Dist ct = percentiles_of(ct_hist);
   std::printf("  cyclictest             %10.1f %10.1f %10.1f %10.1f %10llu\n", ct.p50_us, ct.p99_us, ct.p999_us,
               ct.max_us, (unsigned long long)ct.samples);
   // cyclictest reports whole microseconds: compare against at least 1 us.
