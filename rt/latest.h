@@ -36,7 +36,7 @@ struct ReadInfo {
 
 class LatestChannel {
  public:
-  static constexpr std::size_t kSlots = 4;
+  static constexpr std::size_t kSlots = 8;  // a reader fails only if the writer laps all 8 during one copy
   static constexpr int kMaxReadTries = 64;
 
   // Allocates every slot now (non-RT). payload_size > 0.
