@@ -51,6 +51,29 @@ std::string resolve(const std::string& file, const std::string& p) {
   return (base / path).lexically_normal().string();
 }
 
+// Plugins read their params by key: a repeated key would silently hide one of the values.
+void check_no_duplicate_keys(const std::string& file, const YAML::Node& node,
+                             const std::string& path) {
+  if (node.IsMap()) {
+    std::vector<std::string> seen;
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string("?");
+      if (it->first.IsScalar()) {
+        if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+          throw ConfigError(loc_of(file, it->first), path + "." + key,
+                            "duplicate key '" + key + "'");
+        }
+        seen.push_back(key);
+      }
+      check_no_duplicate_keys(file, it->second, path + "." + key);
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      check_no_duplicate_keys(file, node[i], path + "[" + std::to_string(i) + "]");
+    }
+  }
+}
+
 void read_plugin_dirs(const MapReader& root, const LoadOptions& options, DaemonConfig& cfg) {
   const YAML::Node dirs = root.require("plugin_dirs");
   const std::string& file = root.file();
@@ -212,6 +235,7 @@ void read_plugins(const MapReader& root, DaemonConfig& cfg) {
       } else if (!params.IsMap()) {
         throw ConfigError(loc_of(f, params), m.path_of("params"), "expected a map");
       } else {
+        check_no_duplicate_keys(f, params, m.path_of("params"));
         p.params = params;
         p.params_loc = loc_of(f, params);
       }

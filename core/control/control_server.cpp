@@ -52,6 +52,7 @@ struct ControlServer::Impl {
   asio::io_context work;     // handler calls
   asio::executor_work_guard<asio::io_context::executor_type> work_guard{work.get_executor()};
   Local::acceptor acceptor{io};
+  asio::steady_timer accept_retry{io};  // backs off after accept errors (e.g. EMFILE)
   std::optional<gid_t> group_gid;
   std::set<std::shared_ptr<Session>> sessions;  // I/O thread only
   AtomicCounters c;
@@ -278,7 +279,15 @@ bool ControlServer::Impl::peer_allowed(Local::socket& s) const {
 void ControlServer::Impl::do_accept() {
   acceptor.async_accept([this](boost::system::error_code ec, Local::socket s) {
     if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
-    if (!ec) {
+    if (ec) {
+      // Out of descriptors or similar: retry later instead of spinning.
+      accept_retry.expires_after(std::chrono::milliseconds(100));
+      accept_retry.async_wait([this](boost::system::error_code wait_ec) {
+        if (!wait_ec && acceptor.is_open()) do_accept();
+      });
+      return;
+    }
+    {
       if (!peer_allowed(s)) {
         bump(c.rejected_peer_credentials);
         send_and_close(s, to_line(make_error(nullptr, kErrorPermissionDenied,
@@ -345,6 +354,7 @@ void ControlServer::stop() {
     asio::post(m.io, [&m] {
       boost::system::error_code ec;
       m.acceptor.close(ec);
+      m.accept_retry.cancel();
       const auto snapshot = m.sessions;
       for (const auto& s : snapshot) s->begin_closing();
     });

@@ -193,6 +193,10 @@ TEST_CASE("bad configurations name file, line, column, key and reason") {
        "/etc/crease/bad.yaml:7:59: plugins[0].ports: expected a map local: global"},
       {"socket is a list", HEAD "daemon:\n  socket: [a]\n",
        "/etc/crease/bad.yaml:7:11: daemon.socket: expected a string, got a list"},
+      {"duplicate key inside params",
+       HEAD "plugins:\n  - name: a\n    library: x\n    loop: control\n    order: 1\n"
+            "    params:\n      pid: {kp: 1, kp: 2}\n",
+       "/etc/crease/bad.yaml:12:20: plugins[0].params.pid.kp: duplicate key 'kp'"},
       {"nan rate", "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: .nan, priority: 1}\n",
        "/etc/crease/bad.yaml:3:24: loops[0].rate_hz: expected a finite number, got '.nan'"},
   };
