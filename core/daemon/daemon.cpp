@@ -1,7 +1,6 @@
 #include "core/daemon/daemon.h"
 
 #include <signal.h>
-#include <systemd/sd-daemon.h>
 
 #include <chrono>
 #include <cstdio>
@@ -11,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/control/protocol.h"
+#include "core/control/sd_notify.h"
 #include "core/control/socket_path.h"
 #include "core/errors.h"
 #include "core/report/render.h"
@@ -108,9 +108,11 @@ int Daemon::run() {
   facts_.affinity_applied &= any_cpu;
   spdlog::info("creased running: {} loops, {} plugins, control socket {}", config_.loops.size(), config_.plugins.size(),
                server_->socket_path());
-  sd_notify(0, "READY=1");
-  std::uint64_t watchdog_usec = 0;
-  const bool watchdog = sd_watchdog_enabled(0, &watchdog_usec) > 0;
+  control::notify_ready("running " + config_.file);
+  // systemd's watchdog wants a ping at least every half interval.
+  const auto watchdog = control::watchdog_interval();
+  const std::int64_t ping_ns = watchdog ? std::chrono::nanoseconds(*watchdog).count() / 2 : 0;
+  std::int64_t next_ping = rt::now_ns();
 
   const std::optional<double> duration = options_.duration_s ? options_.duration_s : d.duration_s;
   sigset_t signals;
@@ -133,8 +135,11 @@ int Daemon::run() {
       break;
     }
     faults_seen = host_->fault_count();
+    if (watchdog && rt::now_ns() >= next_ping) {
+      control::notify_watchdog();
+      next_ping += ping_ns;
+    }
     if (t >= next_progress) {
-      if (watchdog) sd_notify(0, "WATCHDOG=1");
       std::uint64_t overruns = 0;
       for (const Loop* l : host_->loops()) overruns += l->timing().missed_periods.load();
       if (config_.safety.max_overruns_per_s > 0 && double(overruns - overruns_last) > config_.safety.max_overruns_per_s) {
@@ -150,7 +155,7 @@ int Daemon::run() {
       break;
     }
   }
-  sd_notify(0, "STOPPING=1");
+  control::notify_stopping(stop_reason_);
   spdlog::info("stopping: {}", stop_reason_);
   server_->stop();
   host_->stop();  // drives every output safe, deactivates in reverse order
