@@ -1,0 +1,93 @@
+// Plugin `sheet_model` (model loop, 60 Hz by default): the sheet model of seed 000/001 kept
+// on the observed sheet.
+//   in:  keypoints (latest, Keypoints), target_points (latest, TargetPoints),
+//        crease (queue, SheetCreaseEvent), memorize (queue, SheetMemorizeEvent),
+//        reset (queue, SheetResetEvent)
+//   out: sheet_state (latest, SheetState)
+// A step that leaves the state non-finite is rolled back to the last good state and the
+// update returns degraded (counted in sheet_state.rollbacks).
+// Parameters (all optional): nodes_u, nodes_v, width_mm, height_mm, density_g_per_m2,
+// thickness_mm, substeps, keypoint_gain_per_s, target_compliance_m_per_n,
+// compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
+// self_collision (0/1).
+#include <memory>
+
+#include "core/plugin.h"
+#include "core/port_types/keypoints.h"
+#include "core/port_types/sheet_state.h"
+#include "plugins/sheet_model/sheet_runner.h"
+
+namespace {
+
+using namespace crease;
+
+const SheetState kSafeState{};  // zero nodes: readers see "no sheet"
+
+class SheetModelPlugin final : public Plugin {
+ public:
+  void configure(const Params& p, PortBinder& ports) override {
+    sheet::SheetParams sp;
+    sp.grid.nodes_u = p.get_in_range<int>("nodes_u", 15, 2, 64);
+    sp.grid.nodes_v = p.get_in_range<int>("nodes_v", 21, 2, 64);
+    sp.grid.width_mm = p.get_in_range<double>("width_mm", 210.0, 10.0, 2000.0);
+    sp.grid.height_mm = p.get_in_range<double>("height_mm", 297.0, 10.0, 2000.0);
+    sp.grid.areal_density_g_per_m2 = p.get_in_range<double>("density_g_per_m2", 80.0, 1.0, 1000.0);
+    sp.grid.thickness_mm = p.get_in_range<double>("thickness_mm", 1.0, 0.01, 20.0);
+    sp.grid.origin_mm = {0.0, sp.grid.height_mm, 0.5 * sp.grid.thickness_mm};
+    sp.solver.substeps = p.get_in_range<int>("substeps", 10, 1, 100);
+    sp.solver.keypoint_gain_per_s = p.get_in_range<double>("keypoint_gain_per_s", 10.0, 0.0, 1e6);
+    sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);
+    sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
+    sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
+    sp.solver.yield_strain = p.get_in_range<double>("yield_strain", 0.0, 0.0, 1.0);
+    sp.solver.plasticity_rate = p.get_in_range<double>("plasticity_rate", 0.0, 0.0, 0.99);
+    sp.solver.self_collision = p.get_in_range<int>("self_collision", 1, 0, 1) != 0;
+    const double table = p.get_in_range<double>("table_height_mm", 0.0, -1e4, 1e4);
+    runner_ = std::make_unique<sheet::SheetRunner>(sp, table);
+    state_ = std::make_unique<SheetState>();
+    keypoints_buf_ = std::make_unique<Keypoints>();
+    targets_buf_ = std::make_unique<TargetPoints>();
+    keypoints_ = ports.latest_input<Keypoints>("keypoints");
+    targets_ = ports.latest_input<TargetPoints>("target_points");
+    crease_ = ports.queue_input<SheetCreaseEvent>("crease");
+    memorize_ = ports.queue_input<SheetMemorizeEvent>("memorize");
+    reset_ = ports.queue_input<SheetResetEvent>("reset");
+    out_ = ports.latest_output<SheetState>("sheet_state", kSafeState);
+  }
+
+  Status update(const Cycle& cycle) override {
+    if (keypoints_.bound() && keypoints_.read(*keypoints_buf_).is_new()) runner_->observe_keypoints(*keypoints_buf_);
+    if (targets_.bound()) {
+      const auto info = targets_.read(*targets_buf_);
+      if (info.is_new()) runner_->set_targets(*targets_buf_);
+    }
+    SheetResetEvent r;
+    while (reset_.bound() && reset_.try_pop(r)) runner_->apply(r);
+    SheetCreaseEvent c;
+    while (crease_.bound() && crease_.try_pop(c)) runner_->apply(c);
+    SheetMemorizeEvent m;
+    while (memorize_.bound() && memorize_.try_pop(m)) runner_->apply(m);
+    const double dt = cycle.period_ns > 0 ? static_cast<double>(cycle.period_ns) * 1e-9 : 1.0 / 60;
+    const bool ok = runner_->step_rt(dt, cycle.time_ns, *state_);
+    out_.write(*state_, cycle.time_ns);
+    return ok ? Status::ok : Status::degraded;
+  }
+
+  void activate() override { runner_->apply(SheetResetEvent{}); }
+
+ private:
+  std::unique_ptr<sheet::SheetRunner> runner_;
+  std::unique_ptr<SheetState> state_;
+  std::unique_ptr<Keypoints> keypoints_buf_;
+  std::unique_ptr<TargetPoints> targets_buf_;
+  LatestInput<Keypoints> keypoints_;
+  LatestInput<TargetPoints> targets_;
+  QueueInput<SheetCreaseEvent> crease_;
+  QueueInput<SheetMemorizeEvent> memorize_;
+  QueueInput<SheetResetEvent> reset_;
+  LatestOutput<SheetState> out_;
+};
+
+}  // namespace
+
+CREASE_PLUGIN(SheetModelPlugin, "sheet_model", "0.1.0")

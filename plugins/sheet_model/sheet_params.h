@@ -1,0 +1,62 @@
+// Parameters of the sheet model: grid, topology, solver, plasticity, coupling.
+// Internal units: positions mm, time s, mass kg; hence force mN and compliance mm/mN = m/N.
+#pragma once
+
+#include "vec3.h"
+
+namespace crease::sheet {
+
+// A rectangular sheet of nodes_u x nodes_v nodes over width_mm x height_mm.
+struct GridParams {
+  int nodes_u = 15;                      // W, along u (short edge for A4)
+  int nodes_v = 21;                      // H, along v
+  double width_mm = 210.0;               // extent along u
+  double height_mm = 297.0;              // extent along v
+  double areal_density_g_per_m2 = 80.0;  // paper grammage
+  double thickness_mm = 1.0;             // collision thickness (layers keep this apart)
+  // World position of sheet point (0,0) when flat; flat sheet: u -> +x, v -> -y (printed face up).
+  Vec3 origin_mm{0.0, 297.0, 0.5};
+};
+
+enum class Diagonals { none, alternating, both };
+
+// Seed 000's construction by default: structural links with alternating diagonals plus
+// bending links to every node in the (2r+1)^2 box whose city-block distance is in
+// [bend_min_city, bend_max_city]. 15x21 -> 874 + 7848 = 8722 links.
+struct TopologyParams {
+  Diagonals diagonals = Diagonals::alternating;
+  int bend_box_radius = 4;
+  int bend_min_city = 3;
+  int bend_max_city = 8;
+};
+
+struct SolverParams {
+  int substeps = 10;                          // N_s (seed 001 Eq. 1: dt_s = dt / N_s)
+  Vec3 gravity_mm_per_s2{0.0, 0.0, -9810.0};
+  double damping_per_s = 1.0;                 // velocity damping, v *= 1 - damping*dt_s
+  double max_speed_mm_per_s = 1000.0;  // clamp on node speed (hands fold slower); also bounds
+                                       // the jump when a hidden part is seen again
+  double compliance_structural_m_per_n = 1e-7;  // alpha of a structural link at stiffness 1
+  double compliance_bending_m_per_n = 0.05;     // alpha of a bending link at stiffness 1
+  double stiffness = 0.9;          // seed 000 default link stiffness coefficient (0..1]
+  double crease_stiffness = 0.001; // stiffness of links crossing a crease (seed 000 code)
+  // Elasto-plastic links (seed 001 III.C); plasticity_rate 0 disables it.
+  double yield_strain = 0.0;       // eps_Y
+  double plasticity_rate = 0.0;    // a in [0, 1)
+  bool plastic_bending_only = true;
+  // Key-point velocity coupling (seed 000 Eqs. 1-4): gain lambda, 1/s.
+  double keypoint_gain_per_s = 10.0;
+  // Zero-length target springs (seed 001 Eq. 4): alpha_input, m/N.
+  double target_compliance_m_per_n = 1e-6;
+  // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
+  double friction = 0.5;
+  bool self_collision = true;
+};
+
+struct SheetParams {
+  GridParams grid;
+  TopologyParams topology;
+  SolverParams solver;
+};
+
+}  // namespace crease::sheet

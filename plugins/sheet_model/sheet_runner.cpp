@@ -1,0 +1,149 @@
+#include "sheet_runner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "xpbd_sheet.h"
+
+namespace crease::sheet {
+
+SheetRunner::SheetRunner(const SheetParams& params, double table_height_mm)
+    : SheetRunner(std::make_unique<XpbdSheet>(params), table_height_mm) {}
+
+SheetRunner::SheetRunner(std::unique_ptr<SheetModel> model, double table_height_mm)
+    : model_(std::move(model)), predictor_(kMarkerIds * 5) {
+  if (std::isfinite(table_height_mm)) {
+    world_.add_table(table_height_mm);
+    model_->set_collision_world(&world_);
+  }
+  predicted_.resize(SheetModel::kMaxTargets);
+  external_.resize(TargetPoints::kCapacity);
+  last_good_.assign(model_->positions().begin(), model_->positions().end());
+  normals_.resize(model_->node_count());
+  strain_.resize(model_->link_count());
+}
+
+void SheetRunner::observe_keypoints(const Keypoints& k) noexcept {
+  if (!have_epoch_) {
+    epoch_ns_ = k.timestamp_ns;
+    have_epoch_ = true;
+  }
+  const double t = seconds(k.timestamp_ns);
+  const std::uint32_t n = std::min(k.count, Keypoints::kCapacity);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Keypoint& p = k.points[i];
+    const int id = static_cast<int>(p.marker_id) * 5 + std::min<int>(p.corner, 4);
+    predictor_.observe(id, {p.sheet_mm[0], p.sheet_mm[1]}, {p.world_mm[0], p.world_mm[1], p.world_mm[2]}, t);
+  }
+}
+
+void SheetRunner::set_targets(const TargetPoints& t) noexcept {
+  n_external_ = 0;
+  const std::uint32_t n = std::min(t.count, TargetPoints::kCapacity);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const auto& p = t.points[i];
+    external_[n_external_++] = {{p.world_mm[0], p.world_mm[1], p.world_mm[2]}, {p.sheet_mm[0], p.sheet_mm[1]}};
+  }
+}
+
+void SheetRunner::apply(const SheetCreaseEvent& e) noexcept {
+  switch (e.op) {
+    case SheetCreaseEvent::Op::add:  // the model's id shows as the crease's slot
+      (void)model_->add_crease({{e.a_mm[0], e.a_mm[1]}, {e.b_mm[0], e.b_mm[1]}});
+      break;
+    case SheetCreaseEvent::Op::remove:
+      model_->remove_crease(e.id);
+      break;
+    case SheetCreaseEvent::Op::clear:
+      for (int c = 0; c < CreaseSet::kCapacity; ++c) model_->remove_crease(c);
+      break;
+  }
+}
+
+void SheetRunner::apply(const SheetMemorizeEvent& e) noexcept {
+  if (!model_->state_finite()) return;
+  if (e.whole_sheet) {
+    model_->memorize_all();
+  } else {
+    model_->memorize_region({{e.min_mm[0], e.min_mm[1]}, {e.max_mm[0], e.max_mm[1]}});
+  }
+}
+
+void SheetRunner::apply(const SheetResetEvent&) noexcept {
+  model_->reset_rt();
+  predictor_.clear();
+  n_external_ = 0;
+  last_good_.assign(model_->positions().begin(), model_->positions().end());
+}
+
+bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noexcept {
+  if (!have_epoch_) {
+    epoch_ns_ = now_ns;
+    have_epoch_ = true;
+  }
+  int n = predictor_.predict(seconds(now_ns), predicted_);
+  observations_ = static_cast<std::uint32_t>(n);
+  for (int i = 0; i < n_external_ && n < static_cast<int>(predicted_.size()); ++i) predicted_[n++] = external_[i];
+  model_->set_targets(std::span<const TargetPoint>(predicted_.data(), n));
+  model_->step_rt(dt_s);
+  ++steps_;
+  bool ok = model_->state_finite();
+  if (ok) {
+    for (std::size_t i = 0; i < last_good_.size(); ++i) last_good_[i] = model_->positions()[i];
+  } else {
+    model_->set_positions(last_good_);
+    ++rollbacks_;
+  }
+  fill_state(now_ns, out);
+  return ok;
+}
+
+void SheetRunner::fill_state(std::int64_t now_ns, SheetState& out) noexcept {
+  const Grid& g = model_->grid();
+  out.timestamp_ns = now_ns;
+  out.step = steps_;
+  out.nodes_u = static_cast<std::uint16_t>(g.w);
+  out.nodes_v = static_cast<std::uint16_t>(g.h);
+  out.width_mm = static_cast<float>(g.width_mm);
+  out.height_mm = static_cast<float>(g.height_mm);
+  model_->compute_normals(normals_);
+  const auto x = model_->positions();
+  const int n = std::min<int>(g.count(), SheetState::kMaxNodes);
+  for (int i = 0; i < n; ++i) {
+    out.position_mm[i][0] = static_cast<float>(x[i].x);
+    out.position_mm[i][1] = static_cast<float>(x[i].y);
+    out.position_mm[i][2] = static_cast<float>(x[i].z);
+    out.normal[i][0] = static_cast<float>(normals_[i].x);
+    out.normal[i][1] = static_cast<float>(normals_[i].y);
+    out.normal[i][2] = static_cast<float>(normals_[i].z);
+  }
+  model_->compute_strains(strain_);
+  out.link_count = static_cast<std::uint32_t>(std::min<int>(model_->link_count(), SheetState::kMaxLinks));
+  for (std::uint32_t k = 0; k < out.link_count; ++k) out.strain[k] = static_cast<float>(strain_[k]);
+  out.crease_count = 0;
+  const CreaseSet& cs = model_->creases();
+  for (int c = 0; c < CreaseSet::kCapacity && out.crease_count < SheetState::kMaxCreases; ++c) {
+    if (!cs.used(c)) continue;
+    const CreaseLine& l = cs.line(c);
+    out.crease_id[out.crease_count] = c;
+    float* o = out.crease_mm[out.crease_count++];
+    o[0] = static_cast<float>(l.a.u);
+    o[1] = static_cast<float>(l.a.v);
+    o[2] = static_cast<float>(l.b.u);
+    o[3] = static_cast<float>(l.b.v);
+  }
+  // Fit: mean distance of the used targets to the model's sheet points.
+  double err = 0;
+  int used = 0;
+  const int nt = static_cast<int>(observations_);
+  for (int t = 0; t < nt; ++t) {
+    err += norm(model_->interpolate(predicted_[t].sheet_mm) - predicted_[t].world_mm);
+    ++used;
+  }
+  out.fit_error_mm = used > 0 ? static_cast<float>(err / used) : -1.0f;
+  out.observations = observations_;
+  out.rollbacks = rollbacks_;
+}
+
+}  // namespace crease::sheet

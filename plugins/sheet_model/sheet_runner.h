@@ -1,0 +1,64 @@
+// The sheet model as one loop step, independent of the plugin ABI (the plugin wrapper is a
+// thin shell around this; tests drive it directly): observations and model edits in, a
+// SheetState out. A step that leaves the state non-finite is rolled back to the last good
+// state and reported, never propagated. Everything is allocated in the constructor.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/port_types/keypoints.h"
+#include "core/port_types/sheet_state.h"
+#include "collision_world.h"
+#include "keypoint_predictor.h"
+#include "sheet_model.h"
+
+namespace crease::sheet {
+
+class SheetRunner {
+ public:
+  static constexpr int kMarkerIds = 1024;  // key-point id = marker_id * 5 + corner
+
+  // With table_height_mm finite, the table plane z = table_height_mm is a collision shape.
+  explicit SheetRunner(const SheetParams& params, double table_height_mm = 0.0);  // throws std::invalid_argument
+  // Runs a given backend (tests inject faulty ones; the ODE backend).
+  explicit SheetRunner(std::unique_ptr<SheetModel> model, double table_height_mm = 0.0);
+
+  // Inputs (RT). Times are CLOCK_MONOTONIC ns.
+  void observe_keypoints(const Keypoints& k) noexcept;
+  void set_targets(const TargetPoints& t) noexcept;
+  void apply(const SheetCreaseEvent& e) noexcept;
+  void apply(const SheetMemorizeEvent& e) noexcept;
+  void apply(const SheetResetEvent& e) noexcept;
+
+  // Advances the model to now_ns (by dt_s) and writes the state. Returns false when the step
+  // went non-finite and the state was rolled back (the caller reports degraded). RT.
+  bool step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noexcept;
+
+  [[nodiscard]] SheetModel& model() noexcept { return *model_; }
+  [[nodiscard]] std::uint32_t rollbacks() const noexcept { return rollbacks_; }
+
+ private:
+  void fill_state(std::int64_t now_ns, SheetState& out) noexcept;
+  [[nodiscard]] double seconds(std::int64_t ns) const noexcept {
+    return static_cast<double>(ns - epoch_ns_) * 1e-9;
+  }
+
+  CollisionWorld world_;
+  std::unique_ptr<SheetModel> model_;
+  KeypointPredictor predictor_;
+  std::vector<TargetPoint> predicted_;  // predictor output plus target_points, capacity fixed
+  std::vector<TargetPoint> external_;
+  int n_external_ = 0;
+  std::vector<Vec3> last_good_, normals_;
+  std::vector<double> strain_;
+  std::int64_t epoch_ns_ = 0;
+  bool have_epoch_ = false;
+  std::uint64_t steps_ = 0;
+  std::uint32_t rollbacks_ = 0;
+  std::uint32_t observations_ = 0;
+};
+
+}  // namespace crease::sheet

@@ -1,0 +1,152 @@
+// The model-loop step behind the sheet_model plugin: inputs, events, state out, rollback.
+#include "plugins/sheet_model/sheet_runner.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "plugins/sheet_model/fold_script.h"
+#include "plugins/sheet_model/synthetic_markers.h"
+#include "rt/alloc_guard.h"
+
+using namespace crease::sheet;
+
+namespace {
+
+constexpr std::int64_t kFrameNs = 16'666'667;
+
+// Key-points of the analytic half fold at time t (marker ids 0..34, corner 0..4).
+const std::vector<Vec2>& kps_layout() {
+  static const std::vector<Vec2> kps = marker_keypoints(MarkerLayout{});
+  return kps;
+}
+
+void fold_keypoints(const FoldScript& f, double t, std::int64_t ns, crease::Keypoints& k) {
+  const auto& kps = kps_layout();
+  k.timestamp_ns = ns;
+  k.count = static_cast<std::uint32_t>(kps.size());
+  for (std::size_t i = 0; i < kps.size(); ++i) {
+    const Vec3 w = f.position(kps[i], t);
+    k.points[i] = {{float(w.x), float(w.y), float(w.z)}, {float(kps[i].u), float(kps[i].v)}, 0.1f,
+                   static_cast<std::uint16_t>(i / 5), static_cast<std::uint8_t>(i % 5), 0, 3};
+  }
+}
+
+}  // namespace
+
+TEST_CASE("the runner tracks key-points, applies events and publishes a finite state") {
+  SheetParams p;
+  p.solver.substeps = 4;
+  SheetRunner r(p);
+  auto state = std::make_unique<crease::SheetState>();
+  auto kp = std::make_unique<crease::Keypoints>();
+  const FoldScript fold = FoldScript::half_fold(p.grid);
+  crease::SheetCreaseEvent add;
+  add.a_mm[1] = 148.5f;
+  add.b_mm[0] = 210.0f;
+  add.b_mm[1] = 148.5f;
+  r.apply(add);
+  std::int64_t now = 1'000'000'000;
+  for (int f = 0; f < 120; ++f, now += kFrameNs) {
+    if (f % 4 == 0) {
+      fold_keypoints(fold, f / 60.0, now, *kp);
+      r.observe_keypoints(*kp);
+    }
+    REQUIRE(r.step_rt(1.0 / 60, now, *state));
+  }
+  CHECK(state->all_finite());
+  CHECK(state->nodes_u == 15);
+  CHECK(state->link_count == 8722);
+  CHECK(state->crease_count == 1);
+  CHECK(state->observations == 175);
+  CHECK(state->fit_error_mm >= 0.0f);
+  CHECK(state->fit_error_mm < 5.0f);
+  crease::SheetMemorizeEvent mem;
+  r.apply(mem);
+  crease::SheetCreaseEvent rm;
+  rm.op = crease::SheetCreaseEvent::Op::remove;
+  rm.id = state->crease_id[0];
+  r.apply(rm);
+  REQUIRE(r.step_rt(1.0 / 60, now, *state));
+  CHECK(state->crease_count == 0);
+  r.apply(crease::SheetResetEvent{});
+  REQUIRE(r.step_rt(1.0 / 60, now + kFrameNs, *state));
+  // Flat again, resting on the table (mid-surface half a thickness up).
+  CHECK(state->position_mm[0][0] == doctest::Approx(0.0).epsilon(0.01));
+  CHECK(state->position_mm[0][2] == doctest::Approx(0.5).epsilon(0.05));
+}
+
+// A backend that goes non-finite on its third step (as a solver bug would).
+class PoisonedSheet final : public SheetModel {
+ public:
+  explicit PoisonedSheet(const SheetParams& p) : SheetModel(p), x_(flat_), v_(flat_.size()) {}
+  void step_rt(double dt_s) noexcept override {
+    for (Vec3& x : x_) x.z -= 10.0 * dt_s;
+    if (++steps_ == 3) x_[7].y = std::nan("");
+  }
+  std::span<const Vec3> positions() const noexcept override { return x_; }
+  std::span<const Vec3> velocities() const noexcept override { return v_; }
+  void set_positions(std::span<const Vec3> p) noexcept override {
+    for (std::size_t i = 0; i < x_.size() && i < p.size(); ++i) x_[i] = p[i];
+  }
+  const char* backend_name() const noexcept override { return "poisoned"; }
+
+ private:
+  std::vector<Vec3> x_, v_;
+  int steps_ = 0;
+};
+
+TEST_CASE("a non-finite step is rolled back to the last good state and counted") {
+  SheetRunner r(std::make_unique<PoisonedSheet>(SheetParams{}));
+  auto state = std::make_unique<crease::SheetState>();
+  CHECK(r.step_rt(1.0 / 60, 0, *state));
+  CHECK(r.step_rt(1.0 / 60, kFrameNs, *state));
+  const float z_good = state->position_mm[7][2];
+  CHECK_FALSE(r.step_rt(1.0 / 60, 2 * kFrameNs, *state));  // the poisoned step
+  CHECK(r.rollbacks() == 1);
+  CHECK(state->rollbacks == 1);
+  CHECK(state->all_finite());
+  CHECK(state->position_mm[7][2] == z_good);  // the last good state
+  CHECK(r.step_rt(1.0 / 60, 3 * kFrameNs, *state));  // and it goes on
+  CHECK(state->all_finite());
+}
+
+TEST_CASE("absurd but finite targets are bounded by the speed limit") {
+  SheetParams p;
+  p.solver.substeps = 2;
+  SheetRunner r(p);
+  auto state = std::make_unique<crease::SheetState>();
+  auto targets = std::make_unique<crease::TargetPoints>();
+  targets->count = 1;
+  targets->points[0] = {{3e38f, 3e38f, 3e38f}, {100, 100}};
+  r.set_targets(*targets);
+  for (int f = 0; f < 5; ++f) CHECK(r.step_rt(1.0 / 60, f * kFrameNs, *state));
+  CHECK(state->all_finite());
+}
+
+TEST_CASE("the runner's step allocates nothing") {
+  SheetRunner r(SheetParams{});
+  auto state = std::make_unique<crease::SheetState>();
+  auto kp = std::make_unique<crease::Keypoints>();
+  const FoldScript fold = FoldScript::half_fold(SheetParams{}.grid);
+  std::int64_t now = 0;
+  for (int f = 0; f < 8; ++f, now += kFrameNs) {
+    fold_keypoints(fold, f / 60.0, now, *kp);
+    r.observe_keypoints(*kp);
+    (void)r.step_rt(1.0 / 60, now, *state);
+  }
+  const auto before = crease::rt::rt_allocation_count();
+  {
+    crease::rt::ScopedRtMark mark;
+    for (int f = 0; f < 10; ++f, now += kFrameNs) {
+      fold_keypoints(fold, (8 + f) / 60.0, now, *kp);
+      r.observe_keypoints(*kp);
+      (void)r.step_rt(1.0 / 60, now, *state);
+    }
+    r.apply(crease::SheetMemorizeEvent{});
+    r.apply(crease::SheetResetEvent{});
+  }
+  CHECK(crease::rt::rt_allocation_count() == before);
+}
