@@ -1,0 +1,146 @@
+#include "camera_source.h"
+
+#include <cinttypes>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace crease::vision {
+
+namespace {
+std::string frame_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
+  char name[64];
+  std::snprintf(name, sizeof name, "/cam%zu/%06" PRIu64 ".png", cam, index);
+  return dir + name;
+}
+}  // namespace
+
+SimSource::SimSource(std::shared_ptr<const ViewRenderer> renderer, std::function<SheetMesh(std::uint64_t)> mesh_at,
+                     RenderOptions options, std::int64_t period_ns, std::int64_t start_ns)
+    : renderer_(std::move(renderer)),
+      mesh_at_(std::move(mesh_at)),
+      options_(options),
+      period_ns_(period_ns),
+      start_ns_(start_ns) {}
+
+bool SimSource::grab(Frame& frame) {
+  const SheetMesh mesh = mesh_at_(next_);
+  RenderOptions o = options_;
+  o.seed = options_.seed + next_;
+  frame.index = next_;
+  frame.timestamp_ns = start_ns_ + static_cast<std::int64_t>(next_) * period_ns_;
+  frame.images.resize(renderer_->cameras().size());
+  for (std::size_t k = 0; k < frame.images.size(); ++k) {
+    RenderedView v;  // fresh buffers: frame.images[k] keeps this one
+    renderer_->render(static_cast<int>(k), mesh, o, v);
+    frame.images[k] = v.image;
+  }
+  ++next_;
+  return true;
+}
+
+ReplaySource::ReplaySource(const std::string& dir) : dir_(dir) {
+  cameras_ = load_camera_dir(dir);
+  const std::string csv = dir + "/timestamps.csv";
+  std::ifstream in(csv);
+  if (!in) throw std::runtime_error(csv + ": cannot read");
+  std::string line;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (lineno == 1 && line.rfind("frame", 0) == 0) continue;  // header
+    if (line.empty()) continue;
+    std::uint64_t f = 0;
+    long long t = 0;
+    char comma = 0;
+    std::istringstream ls(line);
+    if (!(ls >> f >> comma >> t) || comma != ',')
+      throw std::runtime_error(csv + ": line " + std::to_string(lineno) + ": expected 'frame,timestamp_ns'");
+    stamps_.emplace_back(f, static_cast<std::int64_t>(t));
+  }
+}
+
+bool ReplaySource::grab(Frame& frame) {
+  if (next_ >= stamps_.size()) return false;
+  const auto [index, t] = stamps_[next_++];
+  frame.index = index;
+  frame.timestamp_ns = t;
+  frame.images.resize(cameras_.size());
+  for (std::size_t k = 0; k < cameras_.size(); ++k) {
+    const std::string p = frame_path(dir_, k, index);
+    frame.images[k] = std::filesystem::exists(p) ? cv::imread(p, cv::IMREAD_GRAYSCALE) : cv::Mat();
+    const Camera& c = cameras_[k];
+    if (!frame.images[k].empty() && (frame.images[k].cols != c.width || frame.images[k].rows != c.height))
+      frame.images[k] = cv::Mat();  // wrong size: not this camera's image
+  }
+  return true;
+}
+
+V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices)
+    : cameras_(std::move(cameras)) {
+  if (devices.size() != cameras_.size())
+    throw std::invalid_argument("camera_v4l2: " + std::to_string(devices.size()) + " devices for " +
+                                std::to_string(cameras_.size()) + " calibrations");
+  for (std::size_t k = 0; k < devices.size(); ++k) {
+    cv::VideoCapture cap(devices[k], cv::CAP_V4L2);
+    if (!cap.isOpened()) throw std::runtime_error(devices[k] + ": cannot open video device");
+    cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
+    cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
+    caps_.push_back(std::move(cap));
+  }
+}
+
+bool V4l2Source::grab(Frame& frame) {
+  frame.index = next_++;
+  frame.images.resize(caps_.size());
+  // grab() all first so the exposures are as close in time as the devices allow.
+  std::vector<bool> ok(caps_.size());
+  for (std::size_t k = 0; k < caps_.size(); ++k) ok[k] = caps_[k].isOpened() && caps_[k].grab();
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  frame.timestamp_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+  bool any = false;
+  cv::Mat bgr;
+  for (std::size_t k = 0; k < caps_.size(); ++k) {
+    frame.images[k] = cv::Mat();
+    if (!ok[k] || !caps_[k].retrieve(bgr) || bgr.empty()) continue;  // disconnected: others go on
+    if (bgr.channels() == 3) cv::cvtColor(bgr, frame.images[k], cv::COLOR_BGR2GRAY);
+    else frame.images[k] = bgr.clone();
+    any = true;
+  }
+  return any;
+}
+
+Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras) : dir_(dir), ncam_(cameras.size()) {
+  std::filesystem::create_directories(dir);
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    std::filesystem::create_directories(dir + "/cam" + std::to_string(k));
+    save_camera(cameras[k], dir + "/cam" + std::to_string(k) + ".yaml");
+  }
+  const std::string csv = dir + "/timestamps.csv";
+  stamps_ = std::fopen(csv.c_str(), "w");
+  if (stamps_ == nullptr) throw std::runtime_error(csv + ": cannot open for writing");
+  std::fprintf(stamps_, "frame,timestamp_ns\n");
+}
+
+Recorder::~Recorder() {
+  if (stamps_ != nullptr) std::fclose(stamps_);
+}
+
+void Recorder::write(const Frame& frame) {
+  for (std::size_t k = 0; k < ncam_ && k < frame.images.size(); ++k) {
+    if (frame.images[k].empty()) continue;
+    const std::string p = frame_path(dir_, k, frame.index);
+    if (!cv::imwrite(p, frame.images[k])) throw std::runtime_error(p + ": write failed");
+  }
+  std::fprintf(stamps_, "%" PRIu64 ",%" PRId64 "\n", frame.index, frame.timestamp_ns);
+  std::fflush(stamps_);
+}
+
+}  // namespace crease::vision
