@@ -1,0 +1,35 @@
+// Port payload `tactile`: the newest tactile matrix sample of one hand (5 fingertips x 34
+// taxels, seed 000 Section V), with its age, written by the hand_driver plugin.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/port_types/hand.h"  // DeviceHealth
+
+namespace crease {
+
+struct Tactile {
+  static constexpr char kPortType[] = "crease.Tactile";
+  static constexpr std::uint32_t kPortVersion = 1;
+  static constexpr int kFingertips = 5;
+  static constexpr int kTaxels = 34;
+
+  std::int64_t timestamp_ns = 0;      // CLOCK_MONOTONIC reception time of the sample
+  std::uint32_t device_time_us = 0;
+  std::uint16_t sample_counter = 0;
+  std::uint8_t valid = 0;             // bit f: fingertip f delivered data
+  std::uint8_t fresh = 0;             // 1: a new sample arrived this cycle
+  DeviceHealth health = DeviceHealth::fault;
+  std::int64_t age_ns = 0;            // cycle time minus timestamp_ns
+  float pressure_kpa[kFingertips][kTaxels] = {};
+
+  [[nodiscard]] bool all_finite() const {
+    for (const auto& f : pressure_kpa)
+      for (float x : f)
+        if (!std::isfinite(x)) return false;
+    return true;
+  }
+};
+
+}  // namespace crease

@@ -1,0 +1,70 @@
+#include "drivers/can/recording_can_bus.h"
+
+#include <time.h>
+
+#include <cstring>
+#include <stdexcept>
+
+namespace crease::drivers {
+namespace {
+std::int64_t mono_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
+}
+}  // namespace
+
+RecordingCanBus::RecordingCanBus(CanBus& inner, const std::string& interface, std::size_t capacity)
+    : inner_(inner), ring_(capacity) {
+  if (interface.empty() || interface.size() >= sizeof(interface_) || capacity < 2) {
+    throw std::invalid_argument("recording CAN bus: interface name '" + interface + "' must be 1..15 characters");
+  }
+  std::memcpy(interface_, interface.data(), interface.size());
+}
+
+void RecordingCanBus::record(const CanFrame& f, std::int64_t ts) noexcept {
+  const std::size_t head = head_.load(std::memory_order_relaxed);
+  const std::size_t next = (head + 1) % ring_.size();
+  if (next == tail_.load(std::memory_order_acquire)) {
+    dropped_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  CandumpEntry& e = ring_[head];
+  e.timestamp_ns = ts;
+  std::memcpy(e.interface, interface_, sizeof(e.interface));
+  e.frame = f;
+  head_.store(next, std::memory_order_release);
+}
+
+SendResult RecordingCanBus::send(const CanFrame& f) noexcept {
+  const SendResult r = inner_.send(f);
+  if (r == SendResult::ok) record(f, mono_ns());
+  return r;
+}
+
+std::size_t RecordingCanBus::send_batch(std::span<const CanFrame> frames, SendResult* last) noexcept {
+  const std::size_t n = inner_.send_batch(frames, last);
+  const std::int64_t ts = mono_ns();
+  for (std::size_t i = 0; i < n; ++i) record(frames[i], ts);
+  return n;
+}
+
+RecvResult RecordingCanBus::try_receive(RxFrame& out) noexcept {
+  const RecvResult r = inner_.try_receive(out);
+  if (r == RecvResult::frame || r == RecvResult::error_frame) record(out.frame, out.timestamp_ns);
+  return r;
+}
+
+std::size_t RecordingCanBus::drain_to(CandumpWriter& log) {
+  std::size_t n = 0;
+  std::size_t tail = tail_.load(std::memory_order_relaxed);
+  while (tail != head_.load(std::memory_order_acquire)) {
+    log.write(ring_[tail]);
+    tail = (tail + 1) % ring_.size();
+    tail_.store(tail, std::memory_order_release);
+    ++n;
+  }
+  return n;
+}
+
+}  // namespace crease::drivers

@@ -1,0 +1,152 @@
+#include "drivers/can/socketcand_protocol.h"
+
+#include <cstring>
+
+namespace crease::drivers::socketcand {
+namespace {
+constexpr char kHex[] = "0123456789ABCDEF";
+
+int hexv(char c) noexcept {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+bool is_space(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// Next whitespace-separated token of s starting at *pos.
+std::string_view token(std::string_view s, std::size_t* pos) noexcept {
+  while (*pos < s.size() && is_space(s[*pos])) ++*pos;
+  const std::size_t b = *pos;
+  while (*pos < s.size() && !is_space(s[*pos])) ++*pos;
+  return s.substr(b, *pos - b);
+}
+
+bool parse_hex(std::string_view t, std::uint32_t max_digits, std::uint32_t* out) noexcept {
+  if (t.empty() || t.size() > max_digits) return false;
+  std::uint32_t v = 0;
+  for (char c : t) {
+    const int h = hexv(c);
+    if (h < 0) return false;
+    v = (v << 4) | static_cast<std::uint32_t>(h);
+  }
+  *out = v;
+  return true;
+}
+}  // namespace
+
+bool parse_message(std::string_view s, Message& out) noexcept {
+  out = Message{};
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  if (s.size() < 3 || s.front() != '<' || s.back() != '>') return false;
+  s = s.substr(1, s.size() - 2);
+  std::size_t pos = 0;
+  const std::string_view word = token(s, &pos);
+  if (word == "open") {
+    const std::string_view iface = token(s, &pos);
+    if (iface.empty() || iface.size() >= sizeof(out.interface) || !token(s, &pos).empty()) return false;
+    std::memcpy(out.interface, iface.data(), iface.size());
+    out.command = Command::open;
+    return true;
+  }
+  if (word == "rawmode" || word == "echo") {
+    if (!token(s, &pos).empty()) return false;
+    out.command = word == "rawmode" ? Command::rawmode : Command::echo;
+    return true;
+  }
+  if (word == "send") {
+    std::uint32_t id = 0, len = 0;
+    const std::string_view ids = token(s, &pos);
+    if (!parse_hex(ids, 8, &id) || !parse_hex(token(s, &pos), 2, &len) || len > 8) return false;
+    const bool ext = ids.size() > 3 || id > CAN_SFF_MASK;
+    if (id > CAN_EFF_MASK) return false;
+    out.frame.can_id = ext ? (id | CAN_EFF_FLAG) : id;
+    out.frame.len = static_cast<std::uint8_t>(len);
+    for (std::uint32_t i = 0; i < len; ++i) {
+      std::uint32_t b = 0;
+      if (!parse_hex(token(s, &pos), 2, &b)) return false;
+      out.frame.data[i] = static_cast<std::uint8_t>(b);
+    }
+    if (!token(s, &pos).empty()) return false;
+    out.command = Command::send;
+    return true;
+  }
+  out.command = Command::unknown;
+  return !word.empty();
+}
+
+std::size_t format_frame(const CanFrame& f, std::int64_t ts, char* buf, std::size_t cap) noexcept {
+  if (f.is_fd() || f.is_error() || f.len > 8) return 0;
+  char tmp[96];
+  std::size_t n = 0;
+  auto put = [&](const char* s) {
+    while (*s) tmp[n++] = *s++;
+  };
+  put(" < frame ");  // leading space: see SocketcandBridge (python-can 4.1 buffer handling)
+  const std::uint32_t id = f.id();
+  const int digits = f.is_extended() ? 8 : 3;
+  for (int i = digits - 1; i >= 0; --i) tmp[n++] = kHex[(id >> (4 * i)) & 0xF];
+  tmp[n++] = ' ';
+  if (ts < 0) ts = 0;
+  char num[24];
+  int k = 0;
+  std::uint64_t sec = static_cast<std::uint64_t>(ts / 1'000'000'000);
+  do {
+    num[k++] = static_cast<char>('0' + sec % 10);
+    sec /= 10;
+  } while (sec);
+  while (k) tmp[n++] = num[--k];
+  tmp[n++] = '.';
+  std::uint64_t usec = static_cast<std::uint64_t>((ts % 1'000'000'000) / 1000);
+  for (int i = 5; i >= 0; --i) {
+    tmp[n + static_cast<std::size_t>(i)] = static_cast<char>('0' + usec % 10);
+    usec /= 10;
+  }
+  n += 6;
+  tmp[n++] = ' ';
+  for (std::uint8_t i = 0; i < f.len; ++i) {
+    tmp[n++] = kHex[f.data[i] >> 4];
+    tmp[n++] = kHex[f.data[i] & 0xF];
+  }
+  put(" >");
+  if (n > cap) return 0;
+  std::memcpy(buf, tmp, n);
+  return n;
+}
+
+std::size_t StreamSplitter::feed(const char* data, std::size_t n, const char** msg, std::size_t* len) noexcept {
+  *msg = nullptr;
+  *len = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = data[i];
+    if (!in_message_) {
+      if (c == '<') {
+        in_message_ = true;
+        overflow_ = false;
+        n_ = 0;
+        buf_[n_++] = c;
+      }
+      continue;
+    }
+    if (n_ < sizeof(buf_)) {
+      buf_[n_++] = c;
+    } else {
+      overflow_ = true;
+    }
+    if (c == '>') {
+      in_message_ = false;
+      if (overflow_) {
+        ++dropped_;
+        continue;
+      }
+      *msg = buf_;
+      *len = n_;
+      return i + 1;
+    }
+  }
+  return n;
+}
+
+}  // namespace crease::drivers::socketcand

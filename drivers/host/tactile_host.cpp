@@ -1,0 +1,36 @@
+#include "drivers/host/tactile_host.h"
+
+namespace crease::drivers {
+
+bool TactileHost::read_from_rt(std::int64_t now_ns) noexcept {
+  bool got = false;
+  SerialFrame f;
+  while (link_.poll_from_rt(f)) {
+    tactile::Sample s;
+    if (tactile::decode_sample(f, s) == Decode::ok) {
+      sample_ = s;
+      rx_ns_ = now_ns;
+      ++samples_;
+      got = true;
+    }
+  }
+  const bool stale = samples_ == 0 || now_ns - rx_ns_ > cfg_.max_age_ns;
+  if (stale && (!started_ || now_ns - last_start_ns_ >= cfg_.start_retry_ns)) {
+    std::uint8_t p[2];
+    const std::size_t n = tactile::encode_start(cfg_.rate_hz, p);
+    started_ = link_.send_from_rt(tactile::kTypeStart, {p, n}) || started_;
+    last_start_ns_ = now_ns;
+  }
+  return got;
+}
+
+LinkHealth TactileHost::health(std::int64_t now_ns) const noexcept {
+  if (samples_ == 0 || now_ns - rx_ns_ > cfg_.max_age_ns) return LinkHealth::fault;
+  if (link_.rx_stats().crc_errors + link_.rx_stats().cobs_errors > 0 &&
+      now_ns - rx_ns_ > 2 * 1'000'000'000 / (cfg_.rate_hz ? cfg_.rate_hz : 1)) {
+    return LinkHealth::degraded;
+  }
+  return LinkHealth::ok;
+}
+
+}  // namespace crease::drivers

@@ -1,0 +1,102 @@
+#include "drivers/serial/serial_framing.h"
+
+#include <cstring>
+
+#include "drivers/serial/crc32c.h"
+
+namespace crease::drivers {
+
+std::size_t serial_encode(std::uint8_t seq, std::uint8_t type, std::span<const std::uint8_t> payload,
+                          std::span<std::uint8_t> out) noexcept {
+  if (payload.size() > kSerialMaxPayload) return 0;
+  std::uint8_t body[kSerialMaxBody];
+  const std::size_t len = payload.size();
+  body[0] = seq;
+  body[1] = type;
+  body[2] = static_cast<std::uint8_t>(len & 0xFF);
+  body[3] = static_cast<std::uint8_t>(len >> 8);
+  if (len) std::memcpy(body + kSerialHeader, payload.data(), len);
+  const std::uint32_t crc = crc32c({body, kSerialHeader + len});
+  for (int k = 0; k < 4; ++k) body[kSerialHeader + len + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(crc >> (8 * k));
+  const std::size_t body_len = kSerialHeader + len + 4;
+  if (out.size() < cobs_max_encoded(body_len) + 2) return 0;
+  out[0] = 0;  // leading delimiter: ends any garbage the receiver saw before this frame
+  const std::size_t n = cobs_encode({body, body_len}, out.subspan(1));
+  if (n == 0) return 0;
+  out[n + 1] = 0;
+  return n + 2;
+}
+
+void SerialDeframer::reset() noexcept {
+  n_ = 0;
+  discarding_ = false;
+  have_seq_ = false;
+}
+
+bool SerialDeframer::push(std::uint8_t byte, SerialFrame& out) noexcept {
+  if (byte != 0) {
+    if (discarding_) {
+      ++stats_.bytes_discarded;
+      return false;
+    }
+    if (n_ == sizeof(buf_)) {
+      ++stats_.overlong;
+      stats_.bytes_discarded += n_ + 1;
+      n_ = 0;
+      discarding_ = true;
+      return false;
+    }
+    buf_[n_++] = byte;
+    return false;
+  }
+  // Delimiter: a frame ends here (or an empty run, or the end of a discarded run).
+  const std::size_t n = n_;
+  n_ = 0;
+  if (discarding_) {
+    discarding_ = false;
+    return false;
+  }
+  if (n == 0) return false;
+  std::uint8_t body[kSerialMaxBody];
+  const long m = cobs_decode({buf_, n}, body);
+  if (m < static_cast<long>(kSerialHeader + 4)) {
+    ++stats_.cobs_errors;
+    stats_.bytes_discarded += n;
+    return false;
+  }
+  const std::size_t len = static_cast<std::size_t>(body[2]) | static_cast<std::size_t>(body[3]) << 8;
+  if (len > kSerialMaxPayload || kSerialHeader + len + 4 != static_cast<std::size_t>(m)) {
+    ++stats_.cobs_errors;
+    stats_.bytes_discarded += n;
+    return false;
+  }
+  std::uint32_t crc = 0;
+  for (int k = 0; k < 4; ++k) crc |= static_cast<std::uint32_t>(body[kSerialHeader + len + static_cast<std::size_t>(k)]) << (8 * k);
+  if (crc32c({body, kSerialHeader + len}) != crc) {
+    ++stats_.crc_errors;
+    stats_.bytes_discarded += n;
+    return false;
+  }
+  out.seq = body[0];
+  out.type = body[1];
+  out.len = static_cast<std::uint16_t>(len);
+  if (len) std::memcpy(out.payload, body + kSerialHeader, len);
+  if (have_seq_ && out.seq != static_cast<std::uint8_t>(last_seq_ + 1)) ++stats_.seq_gaps;
+  have_seq_ = true;
+  last_seq_ = out.seq;
+  ++stats_.frames;
+  return true;
+}
+
+std::size_t SerialDeframer::feed(std::span<const std::uint8_t> bytes, SerialFrame& out, bool* got) noexcept {
+  *got = false;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (push(bytes[i], out)) {
+      *got = true;
+      return i + 1;
+    }
+  }
+  return bytes.size();
+}
+
+}  // namespace crease::drivers

@@ -1,0 +1,153 @@
+#include "drivers/simdevice/sim_arm.h"
+
+#include <cmath>
+
+namespace crease::drivers::sim {
+
+SimArm::SimArm(CanBus& bus, const SimArmConfig& cfg) noexcept : bus_(bus), cfg_(cfg) { drive_.power_up(); }
+
+void SimArm::send(const CanFrame& f) noexcept {
+  if (silent_.load(std::memory_order_relaxed)) return;
+  if (bus_.send(f) != SendResult::ok) ++counters_.send_failures;
+}
+
+void SimArm::emcy(std::uint16_t code, std::int64_t now_ns) noexcept {
+  canopen::Emcy e{cfg_.node, code, static_cast<std::uint8_t>(code ? 0x01 : 0), 0,
+                  static_cast<std::uint32_t>((now_ns - t0_ns_) / 1000)};
+  send(canopen::encode_emcy(e));
+  ++counters_.emcy_sent;
+}
+
+void SimArm::on_frame(const CanFrame& f, std::int64_t now_ns) noexcept {
+  canopen::NmtCommand nc;
+  std::uint8_t node;
+  if (canopen::decode_nmt(f, nc, node)) {
+    if (node != 0 && node != cfg_.node) return;
+    if (nc == canopen::NmtCommand::start) nmt_ = canopen::NmtState::operational;
+    if (nc == canopen::NmtCommand::stop) nmt_ = canopen::NmtState::stopped;
+    if (nc == canopen::NmtCommand::pre_operational) nmt_ = canopen::NmtState::pre_operational;
+    if (nc == canopen::NmtCommand::reset_node) booted_ = false;
+    send(canopen::encode_heartbeat(cfg_.node, nmt_));
+    return;
+  }
+  std::uint8_t counter;
+  if (canopen::decode_sync(f, counter)) {
+    ++counters_.syncs;
+    sync_counter_ = counter;
+    if (nmt_ == canopen::NmtState::operational) {
+      integrate(now_ns);
+      send_status();
+    }
+    return;
+  }
+  arm::Command c;
+  const Decode d = arm::decode(cfg_.node, f, c);
+  if (d == Decode::bad_crc) ++counters_.bad_crc;
+  if (d != Decode::ok || nmt_ != canopen::NmtState::operational) return;
+  ++counters_.commands;
+  integrate(now_ns);
+  cmd_seq_ = c.seq;
+  last_cmd_ns_ = now_ns;
+  controlword_ = c.controlword;
+  const cia402::State before = drive_.state();
+  drive_.step(c.controlword, fault_.load(std::memory_order_relaxed));
+  if (before != cia402::State::operation_enabled && drive_.operation_enabled()) {
+    for (int j = 0; j < arm::kJoints; ++j) pos_sp_[j] = pos_[j];  // no jump on enable
+  }
+  if (watchdog_tripped_) {
+    watchdog_tripped_ = false;
+    emcy(canopen::kEmcyReset, now_ns);
+  }
+  mode_ = c.mode;
+  if (drive_.operation_enabled()) {
+    for (int j = 0; j < arm::kJoints; ++j) {
+      pos_sp_[j] = c.position_rad[j];
+      vel_sp_[j] = c.velocity_rad_s[j];
+    }
+  }
+}
+
+void SimArm::integrate(std::int64_t now_ns) noexcept {
+  const double dt = static_cast<double>(now_ns - last_step_ns_) * 1e-9;
+  last_step_ns_ = now_ns;
+  if (dt <= 0) return;
+  const double a = 1.0 - std::exp(-dt / cfg_.tau_s);
+  for (int j = 0; j < arm::kJoints; ++j) {
+    float vel_target = 0.0f;
+    if (drive_.operation_enabled()) {
+      if (mode_ == arm::kModeCyclicPosition) {
+        const float before = pos_[j];
+        pos_[j] += static_cast<float>(a * (pos_sp_[j] - pos_[j]));
+        vel_[j] = static_cast<float>((pos_[j] - before) / dt);
+        continue;
+      }
+      vel_target = vel_sp_[j];
+    }
+    // Velocity mode, quick stop and every other state: velocity lags to its target (0 = stop).
+    vel_[j] += static_cast<float>(a * (vel_target - vel_[j]));
+    pos_[j] += static_cast<float>(vel_[j] * dt);
+  }
+}
+
+void SimArm::send_status() noexcept {
+  arm::Status s;
+  s.cmd_seq = cmd_seq_;
+  s.statusword = cia402::statusword(drive_.state());
+  s.device_time_us = static_cast<std::uint32_t>((last_step_ns_ - t0_ns_) / 1000);
+  s.valid = 0x7F;
+  s.mode = mode_;
+  s.error_code = error_code_;
+  s.sync_counter = sync_counter_;
+  s.nmt = nmt_;
+  for (int j = 0; j < arm::kJoints; ++j) {
+    s.position_rad[j] = pos_[j];
+    s.velocity_rad_s[j] = vel_[j];
+  }
+  send(arm::encode(cfg_.node, s));
+  ++counters_.statuses_sent;
+}
+
+void SimArm::step(std::int64_t now_ns) noexcept {
+  if (!booted_) {
+    booted_ = true;
+    t0_ns_ = last_step_ns_ = last_cmd_ns_ = last_heartbeat_ns_ = now_ns;
+    send(canopen::encode_heartbeat(cfg_.node, canopen::NmtState::boot_up));
+    nmt_ = cfg_.auto_start ? canopen::NmtState::operational : canopen::NmtState::pre_operational;
+  }
+  RxFrame rx;
+  for (int i = 0; i < 64; ++i) {
+    const RecvResult r = bus_.try_receive(rx);
+    if (r == RecvResult::empty || r == RecvResult::error) break;
+    if (r == RecvResult::frame) on_frame(rx.frame, now_ns);
+  }
+  if (bus_.state() == BusState::bus_off) bus_.restart();
+  const bool fault = fault_.load(std::memory_order_relaxed);
+  if (fault && !fault_reported_) {
+    fault_reported_ = true;
+    error_code_ = canopen::kEmcyJointFault;
+    drive_.raise_fault();
+    emcy(canopen::kEmcyJointFault, now_ns);
+  } else if (!fault && fault_reported_ && drive_.state() != cia402::State::fault &&
+             drive_.state() != cia402::State::fault_reaction_active) {
+    fault_reported_ = false;
+    error_code_ = 0;
+    emcy(canopen::kEmcyReset, now_ns);
+  }
+  if (drive_.state() == cia402::State::fault_reaction_active) drive_.step(controlword_, fault);
+  if (drive_.operation_enabled() && now_ns - last_cmd_ns_ > cfg_.watchdog_ns) {
+    integrate(now_ns);
+    drive_.quick_stop();
+    watchdog_tripped_ = true;
+    ++counters_.watchdog_trips;
+    emcy(canopen::kEmcyHostTimeout, now_ns);
+  }
+  integrate(now_ns);
+  if (now_ns - last_heartbeat_ns_ >= cfg_.heartbeat_period_ns) {
+    last_heartbeat_ns_ = now_ns;
+    send(canopen::encode_heartbeat(cfg_.node, nmt_));
+  }
+  drive_pub_.store(drive_.state());
+  for (int j = 0; j < arm::kJoints; ++j) pos_pub_[j].store(pos_[j], std::memory_order_relaxed);
+}
+
+}  // namespace crease::drivers::sim

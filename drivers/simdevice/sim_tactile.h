@@ -1,0 +1,34 @@
+// SimTactile: the device side of the tactile protocol (drivers/README.md §6) on a byte fd (a
+// pty master). After Start it streams samples at the requested rate; each fingertip's taxels
+// follow the contact force set by the world (a fixed bell-shaped footprint, 10 kPa per N at
+// the centre taxel). step() is non-blocking.
+#pragma once
+
+#include <atomic>
+
+#include "drivers/protocol/tactile_protocol.h"
+#include "drivers/serial/serial_port.h"
+
+namespace crease::drivers::sim {
+
+class SimTactile {
+ public:
+  explicit SimTactile(int fd) noexcept : link_(fd) {}
+  void step(std::int64_t now_ns) noexcept;
+  void set_contact_force(int fingertip, float force_n) noexcept { force_[fingertip].store(force_n); }
+  void set_silent(bool s) noexcept { silent_.store(s); }
+  [[nodiscard]] std::uint64_t samples_sent() const noexcept { return sent_.load(); }
+  [[nodiscard]] std::uint16_t rate_hz() const noexcept { return rate_pub_.load(); }
+
+ private:
+  SerialLink link_;
+  std::uint16_t rate_hz_ = 0;
+  std::uint16_t counter_ = 0;
+  std::int64_t next_ns_ = 0, t0_ns_ = 0;
+  std::atomic<std::uint64_t> sent_{0};
+  std::atomic<std::uint16_t> rate_pub_{0};
+  std::atomic<float> force_[tactile::kFingertips] = {};
+  std::atomic<bool> silent_{false};
+};
+
+}  // namespace crease::drivers::sim

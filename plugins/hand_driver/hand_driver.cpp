@@ -1,0 +1,158 @@
+// Plugin `hand_driver`: one 20-joint hand over CAN FD (and, optionally, its tactile matrix
+// over serial) in the 1 kHz control loop. Non-blocking I/O only.
+//   input  hand_command (latest HandCommand)
+//   output hand_state   (latest HandState: positions, health, freshness, acks)
+//   output tactile      (latest Tactile, when `tactile_device` is set)
+// Parameters:
+//   bus_kind        "mock" (user-space bus, default) or "socketcan"
+//   bus             mock bus name, or the SocketCAN interface (e.g. can0)        required
+//   node            device node id 1..126                                         required
+//   host_node       our node id on a mock bus (default 100)
+//   pressure_sensors true for the left hand's air-pressure sensors (default false)
+//   tactile_device  serial device of the tactile matrix (default: none)
+//   tactile_rate_hz 1..1000 (default 250)
+//   timeout_cycles  cycles without a fresh status before fault (default 2)
+//   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
+// A link fault (device silent, bus-off, CRC errors, emergency) commands the safe state (hold,
+// zero force) in the same cycle and is reported as Status::degraded with health = fault in
+// hand_state: the plugin stays scheduled so it recovers by itself when the device returns,
+// sending the newest command, never a backlog. Before the first command arrives it holds.
+#include <memory>
+#include <string>
+
+#include "core/plugin.h"
+#include "core/port_types/hand.h"
+#include "core/port_types/tactile.h"
+#include "drivers/can/mock_can_bus.h"
+#include "drivers/can/socket_can_bus.h"
+#include "drivers/host/hand_host.h"
+#include "drivers/host/tactile_host.h"
+
+namespace {
+using namespace crease;
+namespace dr = crease::drivers;
+
+DeviceHealth to_health(dr::LinkHealth h) {
+  switch (h) {
+    case dr::LinkHealth::ok: return DeviceHealth::ok;
+    case dr::LinkHealth::degraded: return DeviceHealth::degraded;
+    case dr::LinkHealth::fault: return DeviceHealth::fault;
+  }
+  return DeviceHealth::fault;
+}
+
+class HandDriver final : public Plugin {
+ public:
+  void configure(const Params& p, PortBinder& ports) override {
+    const std::string kind = p.get<std::string>("bus_kind", "mock");
+    const std::string bus = p.get<std::string>("bus");
+    dr::HandHostConfig cfg;
+    cfg.node = static_cast<std::uint8_t>(p.get_in_range<int>("node", 1, 1, 126));
+    cfg.pressure_sensors = p.get<bool>("pressure_sensors", false);
+    cfg.monitor.timeout_cycles = p.get_in_range<int>("timeout_cycles", 2, 1, 100);
+    cfg.monitor.crc_threshold = p.get_in_range<int>("crc_threshold", 10, 0, 1000);
+    if (kind == "mock") {
+      const auto host_node = static_cast<std::uint32_t>(p.get_in_range<int>("host_node", 100, 0, 100000));
+      try {
+        bus_ = std::make_unique<dr::MockCanBus>(dr::MockCanBusConfig{bus, host_node, 1'000'000, 5'000'000});
+      } catch (const std::exception& e) {
+        p.fail("bus", e.what());
+      }
+    } else if (kind == "socketcan") {
+      try {
+        bus_ = std::make_unique<dr::SocketCanBus>(dr::SocketCanConfig{bus, true, {}, false});
+      } catch (const std::exception& e) {
+        p.fail("bus", e.what());
+      }
+    } else {
+      p.fail("bus_kind", "must be 'mock' or 'socketcan', got '" + kind + "'");
+    }
+    host_ = std::make_unique<dr::HandHost>(*bus_, cfg);
+    if (p.has("tactile_device")) {
+      const std::string dev = p.get<std::string>("tactile_device");
+      try {
+        serial_ = std::make_unique<dr::SerialPort>(dr::SerialConfig{dev, 1'000'000, false});
+      } catch (const std::exception& e) {
+        p.fail("tactile_device", e.what());
+      }
+      dr::TactileHostConfig tc;
+      tc.rate_hz = static_cast<std::uint16_t>(p.get_in_range<int>("tactile_rate_hz", 250, 1, 1000));
+      tactile_host_ = std::make_unique<dr::TactileHost>(serial_->fd(), tc);
+      tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
+    }
+    command_in_ = ports.latest_input<HandCommand>("hand_command");
+    state_out_ = ports.latest_output<HandState>("hand_state", HandState{});
+  }
+
+  Status update(const Cycle& cycle) override {
+    const std::int64_t now = cycle.time_ns;
+    host_->read_from_rt(now);
+    const dr::HandReading& r = host_->reading();
+    const dr::LinkCounters& c = host_->monitor().counters();
+    state_.timestamp_ns = r.status_rx_ns;
+    state_.device_time_us = r.status.device_time_us;
+    state_.valid = r.fresh ? r.status.valid : 0;
+    for (int j = 0; j < HandState::kJoints; ++j) state_.position_rad[j] = r.status.position_rad[j];
+    for (int k = 0; k < HandState::kPressureSensors; ++k) state_.pressure_kpa[k] = r.pressure.pressure_kpa[k];
+    state_.pressure_valid = r.pressure_fresh ? r.pressure.valid : 0;
+    state_.fresh = r.fresh ? 1 : 0;
+    state_.health = to_health(host_->health());
+    state_.acked_seq = host_->monitor().last_acked_seq();
+    state_.commands_sent = c.commands_sent;
+    state_.commands_failed = c.commands_failed;
+
+    HandCommand in;
+    if (command_in_.read(in).has_data()) {
+      command_ = in;
+      have_command_ = true;
+    }
+    dr::hand::Command cmd;
+    dr::hand::Stiffness stiff;
+    if (have_command_) {
+      cmd.flags = command_.enable ? dr::hand::kCmdEnable : 0;
+      for (int j = 0; j < HandCommand::kJoints; ++j) {
+        cmd.target_rad[j] = command_.target_rad[j];
+        stiff.stiffness_nm_per_rad[j] = command_.stiffness_nm_per_rad[j];
+      }
+    } else {
+      for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
+    }
+    host_->write_from_rt(cmd, stiff, now);
+    state_.safe_state = (host_->commanding_safe_state() || !cmd.flags) ? 1 : 0;
+    state_out_.write(state_, now);
+
+    Status status = host_->health() == dr::LinkHealth::ok ? Status::ok : Status::degraded;
+    if (tactile_host_) {
+      const bool got = tactile_host_->read_from_rt(now);
+      const dr::tactile::Sample& s = tactile_host_->sample();
+      tactile_.timestamp_ns = tactile_host_->sample_rx_ns();
+      tactile_.device_time_us = s.device_time_us;
+      tactile_.sample_counter = s.sample_counter;
+      tactile_.valid = s.valid;
+      tactile_.fresh = got ? 1 : 0;
+      tactile_.health = to_health(tactile_host_->health(now));
+      tactile_.age_ns = tactile_host_->samples() ? now - tactile_.timestamp_ns : 0;
+      for (int f = 0; f < Tactile::kFingertips; ++f)
+        for (int t = 0; t < Tactile::kTaxels; ++t) tactile_.pressure_kpa[f][t] = s.pressure_kpa[f][t];
+      tactile_out_.write(tactile_, now);
+      if (tactile_.health != DeviceHealth::ok) status = Status::degraded;
+    }
+    return status;
+  }
+
+ private:
+  std::unique_ptr<dr::CanBus> bus_;
+  std::unique_ptr<dr::HandHost> host_;
+  std::unique_ptr<dr::SerialPort> serial_;
+  std::unique_ptr<dr::TactileHost> tactile_host_;
+  LatestInput<HandCommand> command_in_;
+  LatestOutput<HandState> state_out_;
+  LatestOutput<Tactile> tactile_out_;
+  HandCommand command_;
+  bool have_command_ = false;
+  HandState state_;
+  Tactile tactile_;
+};
+}  // namespace
+
+CREASE_PLUGIN(HandDriver, "hand_driver", "1.0.0")

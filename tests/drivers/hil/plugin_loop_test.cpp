@@ -1,0 +1,82 @@
+// hand_driver x2 and arm_driver x2 as plugins in a PluginHost 1 kHz loop, the four simulated
+// devices as crease-simdevice processes on their mocked buses (brokers in this process).
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "core/plugin_host.h"
+#include "core/port_types/arm.h"
+#include "core/port_types/hand.h"
+#include "hil_rig.h"
+#include "rt/alloc_guard.h"
+
+using namespace crease;
+using crease::drivers::testing::Rig;
+
+namespace {
+// Each instance's ports get its name as prefix (hand_r.hand_state, hand_r.hand_command, ...).
+InstanceSpec spec(const std::string& name, const std::string& lib, int order, const std::string& yaml) {
+  InstanceSpec s;
+  const std::string kind = lib == "hand_driver" ? "hand" : "arm";
+  s.ports = {{kind + "_state", name + "." + kind + "_state"}, {kind + "_command", name + "." + kind + "_command"}};
+  s.name = name;
+  s.library = lib;
+  s.loop = "control";
+  s.order = order;
+  s.params = Params(YAML::Load(yaml), "test.yaml", name + ".params");
+  return s;
+}
+template <class T>
+T read_port(PluginHost& host, const std::string& port) {
+  T v{};
+  const auto* ch = host.ports().find_latest(port);
+  REQUIRE_MESSAGE(ch != nullptr, port);
+  ch->read(&v, 0);
+  return v;
+}
+}  // namespace
+
+TEST_CASE("four driver plugins in the control loop against four device processes, 5 s") {
+  Rig rig;  // its own host links stay idle: the plugins join each bus as node 101
+  REQUIRE(rig.all_spawned());
+  for (int i = 0; i < 500 && !rig.all_connected(); ++i) ::usleep(2000);
+  REQUIRE(rig.all_connected());
+  for (auto& h : rig.hands) h.reset();  // the rig's own host links and their idle nodes leave
+  for (auto& a : rig.arms) a.reset();
+  rig.buses.clear();
+  PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"control", 1000.0, rig.fifo ? 80 : 0, -1});
+  host.add_instance(spec("hand_r", "hand_driver", 1, "{bus: " + rig.bus_name(0) + ", node: 1, host_node: 101}"));
+  host.add_instance(spec("hand_l", "hand_driver", 2,
+                         "{bus: " + rig.bus_name(1) + ", node: 2, host_node: 101, pressure_sensors: true}"));
+  host.add_instance(spec("arm_r", "arm_driver", 3, "{bus: " + rig.bus_name(2) + ", node: 10, host_node: 101}"));
+  host.add_instance(spec("arm_l", "arm_driver", 4, "{bus: " + rig.bus_name(3) + ", node: 11, host_node: 101}"));
+  host.start();
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const auto allocs = rt::rt_allocation_count();
+  HandState h0 = read_port<HandState>(host, "hand_r.hand_state");
+  ArmState a0 = read_port<ArmState>(host, "arm_r.arm_state");
+  std::this_thread::sleep_for(std::chrono::seconds(4));
+  CHECK(rt::rt_allocation_count() == allocs);  // steady state: no allocation on the loop thread
+  const HandState h1 = read_port<HandState>(host, "hand_r.hand_state");
+  const HandState hl = read_port<HandState>(host, "hand_l.hand_state");
+  const ArmState a1 = read_port<ArmState>(host, "arm_r.arm_state");
+  const ArmState al = read_port<ArmState>(host, "arm_l.arm_state");
+  host.stop();
+  const std::uint64_t pct = rig.fifo ? 1 : 15;
+  const auto sent_h = h1.commands_sent - h0.commands_sent;
+  const auto sent_a = a1.commands_sent - a0.commands_sent;
+  MESSAGE("hand_r sent " << sent_h << " failed " << h1.commands_failed - h0.commands_failed << "; arm_r sent " << sent_a
+                         << " failed " << a1.commands_failed - a0.commands_failed);
+  CHECK(sent_h > 3500);
+  CHECK(sent_a > 3500);
+  CHECK((h1.commands_failed - h0.commands_failed) * 100 <= sent_h * pct);
+  CHECK((a1.commands_failed - a0.commands_failed) * 100 <= sent_a * pct);
+  CHECK(hl.commands_failed * 100 <= hl.commands_sent * pct + 300);  // start-up cycles included
+  CHECK(al.commands_failed * 100 <= al.commands_sent * pct + 300);
+  CHECK(a1.drive_state == 4);  // operation enabled
+  CHECK(al.drive_state == 4);
+  CHECK(h1.health != DeviceHealth::fault);
+  CHECK(a1.health != DeviceHealth::fault);
+}

@@ -1,0 +1,142 @@
+#include "drivers/serial/serial_framing.h"
+
+#include <doctest/doctest.h>
+
+#include <random>
+#include <vector>
+
+#include "drivers/serial/cobs.h"
+#include "drivers/serial/crc32c.h"
+#include "rt/alloc_guard.h"
+
+using namespace crease::drivers;
+using Bytes = std::vector<std::uint8_t>;
+
+TEST_CASE("CRC-32C check value") {
+  const Bytes s = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+  CHECK(crc32c(s) == 0xE3069283u);
+  CHECK(crc32c_update(crc32c({s.data(), 4}), {s.data() + 4, 5}) == 0xE3069283u);
+}
+
+TEST_CASE("COBS known vectors and round trips") {
+  auto enc = [](const Bytes& in) {
+    Bytes out(cobs_max_encoded(in.size()));
+    out.resize(cobs_encode(in, out));
+    return out;
+  };
+  CHECK(enc({0x00}) == Bytes{0x01, 0x01});
+  CHECK(enc({0x00, 0x00}) == Bytes{0x01, 0x01, 0x01});
+  CHECK(enc({0x11, 0x22, 0x00, 0x33}) == Bytes{0x03, 0x11, 0x22, 0x02, 0x33});
+  CHECK(enc({0x11, 0x00, 0x00, 0x00}) == Bytes{0x02, 0x11, 0x01, 0x01, 0x01});
+  Bytes run254(254);
+  for (std::size_t i = 0; i < run254.size(); ++i) run254[i] = static_cast<std::uint8_t>(i + 1);
+  const Bytes e254 = enc(run254);
+  CHECK(e254.size() == 256);
+  CHECK(e254[0] == 0xFF);
+  std::mt19937 rng(7);
+  for (int t = 0; t < 500; ++t) {
+    Bytes in(rng() % 700);
+    for (auto& b : in) b = static_cast<std::uint8_t>(rng() % 4 == 0 ? 0 : rng());
+    const Bytes e = enc(in);
+    for (auto b : e) REQUIRE(b != 0);
+    Bytes out(in.size() + 1);
+    const long n = cobs_decode(e, out);
+    REQUIRE(n == static_cast<long>(in.size()));
+    out.resize(static_cast<std::size_t>(n));
+    CHECK(out == in);
+  }
+  Bytes out(16);
+  CHECK(cobs_decode(Bytes{0x05, 0x11}, out) == -1);        // code runs past the end
+  CHECK(cobs_decode(Bytes{0x03, 0x11, 0x00}, out) == -1);  // zero inside
+}
+
+namespace {
+Bytes wire(std::uint8_t seq, std::uint8_t type, const Bytes& payload) {
+  Bytes w(kSerialMaxWire);
+  w.resize(serial_encode(seq, type, payload, w));
+  return w;
+}
+}  // namespace
+
+TEST_CASE("frames decode; garbage costs at most the frame it hits; corruption is never accepted") {
+  std::mt19937 rng(11);
+  SerialDeframer d;
+  SerialFrame f;
+  std::vector<Bytes> sent;
+  Bytes stream;
+  for (int i = 0; i < 300; ++i) {
+    Bytes p(rng() % 200);
+    for (auto& b : p) b = static_cast<std::uint8_t>(rng());
+    const Bytes w = wire(static_cast<std::uint8_t>(i), 3, p);
+    sent.push_back(p);
+    if (i % 10 == 5) {  // garbage between frames (may include zeros)
+      for (int k = 0; k < 37; ++k) stream.push_back(static_cast<std::uint8_t>(rng() % 3 == 0 ? 0 : rng()));
+    }
+    stream.insert(stream.end(), w.begin(), w.end());
+  }
+  int got = 0;
+  for (std::uint8_t b : stream) {
+    if (d.push(b, f)) {
+      REQUIRE(got < 300);
+      CHECK(f.seq == static_cast<std::uint8_t>(got));
+      CHECK(Bytes(f.payload, f.payload + f.len) == sent[static_cast<std::size_t>(got)]);
+      ++got;
+    }
+  }
+  CHECK(got == 300);  // garbage between frames never costs a valid frame
+  CHECK(d.stats().seq_gaps == 0);
+
+  // Bit flips inside frames: the damaged frame is dropped, its successor is accepted.
+  SerialDeframer d2;
+  int accepted = 0, damaged = 0;
+  for (int i = 0; i < 400; ++i) {
+    Bytes p(8 + rng() % 100);
+    for (auto& b : p) b = static_cast<std::uint8_t>(rng());
+    Bytes w = wire(static_cast<std::uint8_t>(i), 1, p);
+    const bool flip = i % 3 == 1;
+    if (flip) {
+      const std::size_t at = rng() % (w.size() - 1);
+      w[at] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+      ++damaged;
+    }
+    bool this_one = false;
+    for (std::uint8_t b : w) {
+      if (d2.push(b, f)) {
+        CHECK(Bytes(f.payload, f.payload + f.len) == p);  // never a corrupted payload
+        this_one = true;
+      }
+    }
+    if (!flip) CHECK(this_one);  // resynchronised within one frame
+    accepted += this_one ? 1 : 0;
+  }
+  CHECK(accepted >= 400 - damaged);
+  CHECK(d2.stats().crc_errors + d2.stats().cobs_errors > 0);
+}
+
+TEST_CASE("an over-long run is discarded up to the next delimiter") {
+  SerialDeframer d;
+  SerialFrame f;
+  for (std::size_t i = 0; i < 3 * kSerialMaxWire; ++i) CHECK_FALSE(d.push(0x55, f));
+  const Bytes w = wire(9, 2, {1, 2, 3});
+  int got = 0;
+  for (std::uint8_t b : w) got += d.push(b, f) ? 1 : 0;
+  CHECK(got == 1);  // the frame's leading delimiter ends the discarded run
+  CHECK(d.stats().overlong == 1);
+  Bytes big(kSerialMaxPayload + 1);
+  Bytes out(kSerialMaxWire);
+  CHECK(serial_encode(0, 0, big, out) == 0);
+}
+
+TEST_CASE("deframing does not allocate") {
+  SerialDeframer d;
+  SerialFrame f;
+  const Bytes w = wire(1, 1, Bytes(300, 0xAB));
+  const auto before = crease::rt::rt_allocation_count();
+  {
+    crease::rt::ScopedRtMark mark;
+    for (int i = 0; i < 10; ++i)
+      for (std::uint8_t b : w) (void)d.push(b, f);
+  }
+  CHECK(crease::rt::rt_allocation_count() == before);
+  CHECK(d.stats().frames == 10);
+}

@@ -1,0 +1,389 @@
+// crease-bench bus [--rtt N] [--seconds S] [--cycles N]
+// Mock CAN bus round trip (through the broker) beside a bare AF_UNIX SOCK_SEQPACKET ping-pong;
+// sustained frames/s with loss and reordering counted; pty serial round trip (framed) beside a
+// raw byte ping-pong on the same pty; one control cycle of four drivers (2 hands, 2 arms:
+// read all, write all) against simulated devices, beside the bare syscall floor.
+#include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_registry.h"
+#include "drivers/can/mock_can_broker.h"
+#include "drivers/can/mock_can_bus.h"
+#include "drivers/host/arm_host.h"
+#include "drivers/host/hand_host.h"
+#include "drivers/serial/serial_port.h"
+#include "drivers/simdevice/device_thread.h"
+#include "drivers/simdevice/sim_arm.h"
+#include "drivers/simdevice/sim_clock.h"
+#include "drivers/simdevice/sim_hand.h"
+
+namespace {
+using namespace crease::drivers;
+using sim::now_ns;
+
+struct Pct {
+  double p50, p99, p999;
+};
+Pct percentiles(std::vector<double> v) {
+  if (v.empty()) return {0, 0, 0};
+  std::sort(v.begin(), v.end());
+  auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))]; };
+  return {at(0.50), at(0.99), at(0.999)};
+}
+
+// SCHED_FIFO for the calling thread (0: back to SCHED_OTHER); false where not permitted.
+bool set_fifo(int prio) {
+  sched_param sp{};
+  sp.sched_priority = prio;
+  return pthread_setschedparam(pthread_self(), prio > 0 ? SCHED_FIFO : SCHED_OTHER, &sp) == 0;
+}
+
+void wait_readable(int fd) {
+  pollfd p{fd, POLLIN, 0};
+  (void)::poll(&p, 1, 1000);
+}
+
+std::string bus_name(const char* tag) { return std::string("bench-") + tag + "-" + std::to_string(::getpid()); }
+
+// --- 1. round trip -----------------------------------------------------------------------
+std::vector<double> mock_rtt(int n) {
+  const std::string name = bus_name("rtt");
+  MockCanBroker broker({name, 0, 0, false});
+  MockCanBus a({name, 1, 0, 0}), b({name, 2, 0, 0});
+  while (broker.connected_nodes() < 2) ::usleep(1000);
+  std::atomic<bool> stop{false};
+  std::thread echo([&] {
+    RxFrame rx;
+    while (!stop.load(std::memory_order_relaxed)) {
+      if (b.try_receive(rx) == RecvResult::frame) {
+        rx.frame.can_id += 1;
+        while (b.send(rx.frame) != SendResult::ok) {
+        }
+      } else {
+        wait_readable(b.fd());
+      }
+    }
+  });
+  std::vector<double> us;
+  us.reserve(static_cast<std::size_t>(n));
+  std::uint8_t payload[64] = {};
+  for (int i = 0; i < n + 200; ++i) {
+    std::memcpy(payload, &i, sizeof(i));
+    const CanFrame f = CanFrame::fd(0x100, payload);
+    const std::int64_t t0 = now_ns();
+    while (a.send(f) != SendResult::ok) {
+    }
+    RxFrame rx;
+    for (;;) {
+      const RecvResult r = a.try_receive(rx);
+      if (r == RecvResult::frame) break;
+      wait_readable(a.fd());
+    }
+    if (i >= 200) us.push_back(static_cast<double>(now_ns() - t0) * 1e-3);
+  }
+  stop = true;
+  CanFrame wake = CanFrame::classic(0x7FF, {});
+  (void)a.send(wake);
+  echo.join();
+  return us;
+}
+
+std::vector<double> socketpair_rtt(int n) {
+  int sv[2];
+  ::socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv);
+  std::thread echo([&] {
+    CanFrame f;
+    for (;;) {
+      const ssize_t r = ::recv(sv[1], &f, sizeof(f), 0);
+      if (r <= 0 || f.can_id == 0x7FF) break;
+      (void)!::send(sv[1], &f, sizeof(f), 0);
+    }
+  });
+  std::vector<double> us;
+  CanFrame f;
+  for (int i = 0; i < n + 200; ++i) {
+    f.can_id = 0x100;
+    const std::int64_t t0 = now_ns();
+    (void)!::send(sv[0], &f, sizeof(f), 0);
+    (void)!::recv(sv[0], &f, sizeof(f), 0);
+    if (i >= 200) us.push_back(static_cast<double>(now_ns() - t0) * 1e-3);
+  }
+  f.can_id = 0x7FF;
+  (void)!::send(sv[0], &f, sizeof(f), 0);
+  echo.join();
+  ::close(sv[0]);
+  ::close(sv[1]);
+  return us;
+}
+
+// --- 2. sustained throughput ---------------------------------------------------------------
+struct Throughput {
+  double fps;
+  std::uint64_t sent, received, lost, reordered;
+};
+Throughput throughput(double seconds) {
+  const std::string name = bus_name("fps");
+  MockCanBroker broker({name, 0, 0, false});
+  MockCanBus tx({name, 1, 0, 0}), rx({name, 2, 0, 0});
+  while (broker.connected_nodes() < 2) ::usleep(1000);
+  std::atomic<bool> done{false};
+  std::atomic<std::uint64_t> sent{0};
+  std::uint64_t received = 0, reordered = 0, expected = 0, lost = 0;
+  std::thread sender([&] {
+    std::uint8_t b[8] = {};
+    const std::int64_t end = now_ns() + static_cast<std::int64_t>(seconds * 1e9);
+    std::uint64_t i = 0;
+    while (now_ns() < end) {
+      for (int k = 0; k < 64; ++k, ++i) {
+        std::memcpy(b, &i, 8);
+        const CanFrame f = CanFrame::classic(0x123, b);
+        while (tx.send(f) != SendResult::ok) std::this_thread::yield();  // back-pressure, not loss
+      }
+    }
+    sent = i;
+    done = true;
+  });
+  const std::int64_t t0 = now_ns();
+  RxFrame r;
+  std::int64_t last_rx = t0;
+  for (;;) {
+    const RecvResult res = rx.try_receive(r);
+    if (res == RecvResult::frame) {
+      std::uint64_t v;
+      std::memcpy(&v, r.frame.data, 8);
+      if (v < expected) ++reordered;
+      else {
+        lost += v - expected;
+        expected = v + 1;
+      }
+      ++received;
+      last_rx = now_ns();
+      continue;
+    }
+    if (done.load() && received + lost >= sent.load()) break;
+    if (done.load() && now_ns() - last_rx > 500'000'000) break;
+    wait_readable(rx.fd());
+  }
+  sender.join();
+  const double dt = static_cast<double>(last_rx - t0) * 1e-9;
+  const std::uint64_t s = sent.load();
+  lost = s > received ? s - received : 0;
+  return {static_cast<double>(received) / dt, s, received, lost, reordered};
+}
+
+// --- 3. serial round trip --------------------------------------------------------------------
+std::vector<double> serial_rtt(int n, bool framed) {
+  PtyPair pty;
+  SerialPort port({pty.slave_path(), 1'000'000, false});
+  std::atomic<bool> stop{false};
+  std::thread echo([&] {
+    SerialLink dev(pty.master_fd());
+    SerialFrame f;
+    std::uint8_t raw[256];
+    while (!stop.load(std::memory_order_relaxed)) {
+      if (framed) {
+        if (dev.poll_from_rt(f)) {
+          (void)dev.send_from_rt(f.type, f.bytes());
+          continue;
+        }
+      } else {
+        const ssize_t k = ::read(pty.master_fd(), raw, sizeof(raw));
+        if (k > 0) {
+          (void)!::write(pty.master_fd(), raw, static_cast<std::size_t>(k));
+          continue;
+        }
+      }
+      wait_readable(pty.master_fd());
+    }
+  });
+  SerialLink host(port.fd());
+  std::vector<double> us;
+  std::uint8_t payload[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+  std::uint8_t raw[64];
+  for (int i = 0; i < n + 100; ++i) {
+    const std::int64_t t0 = now_ns();
+    if (framed) {
+      (void)host.send_from_rt(1, payload);
+      SerialFrame f;
+      while (!host.poll_from_rt(f)) wait_readable(port.fd());
+    } else {
+      (void)!::write(port.fd(), payload, sizeof(payload));
+      std::size_t got = 0;
+      while (got < sizeof(payload)) {
+        const long k = port.read_some_from_rt({raw + got, sizeof(raw) - got});
+        if (k > 0) got += static_cast<std::size_t>(k);
+        else wait_readable(port.fd());
+      }
+    }
+    if (i >= 100) us.push_back(static_cast<double>(now_ns() - t0) * 1e-3);
+  }
+  stop = true;
+  echo.join();
+  return us;
+}
+
+// --- 4. control cycle of four drivers ----------------------------------------------------------
+std::vector<double> control_cycle(int cycles) {
+  std::vector<std::unique_ptr<MockCanBroker>> brokers;
+  std::vector<std::unique_ptr<MockCanBus>> host_buses, dev_buses;
+  for (int i = 0; i < 4; ++i) {
+    const std::string name = bus_name("cyc") + std::to_string(i);
+    brokers.push_back(std::make_unique<MockCanBroker>(MockCanBrokerConfig{name, 1'000'000, 5'000'000, false}));
+    host_buses.push_back(std::make_unique<MockCanBus>(MockCanBusConfig{name, 100, 1'000'000, 5'000'000}));
+    dev_buses.push_back(std::make_unique<MockCanBus>(MockCanBusConfig{name, 1, 1'000'000, 5'000'000}));
+  }
+  sim::SimHand h0(*dev_buses[0], {.node = 1}), h1(*dev_buses[1], {.node = 2, .pressure_sensors = true});
+  sim::SimArm a0(*dev_buses[2], {.node = 10}), a1(*dev_buses[3], {.node = 11});
+  sim::DeviceThread t0(dev_buses[0]->fd(), [&](std::int64_t t) { h0.step(t); }, 1, 70);
+  sim::DeviceThread t1(dev_buses[1]->fd(), [&](std::int64_t t) { h1.step(t); }, 1, 70);
+  sim::DeviceThread t2(dev_buses[2]->fd(), [&](std::int64_t t) { a0.step(t); }, 1, 70);
+  sim::DeviceThread t3(dev_buses[3]->fd(), [&](std::int64_t t) { a1.step(t); }, 1, 70);
+  const bool fifo = set_fifo(80);
+  HandHost hands[2] = {HandHost(*host_buses[0], {.node = 1}), HandHost(*host_buses[1], {.node = 2, .pressure_sensors = true})};
+  ArmHost arms[2] = {ArmHost(*host_buses[2], {.node = 10}), ArmHost(*host_buses[3], {.node = 11})};
+  hand::Command hc;
+  hc.flags = hand::kCmdEnable;
+  hand::Stiffness hs;
+  arm::Command ac;
+  std::vector<double> us;
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  for (int c = 0; c < cycles + 300; ++c) {
+    next.tv_nsec += 1'000'000;
+    if (next.tv_nsec >= 1'000'000'000) {
+      next.tv_nsec -= 1'000'000'000;
+      ++next.tv_sec;
+    }
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    const std::int64_t t = now_ns();
+    for (auto& h : hands) h.read_from_rt(t);
+    for (auto& a : arms) a.read_from_rt(t);
+    for (auto& h : hands) h.write_from_rt(hc, hs, t);
+    for (auto& a : arms) a.write_from_rt(ac, t);
+    if (c >= 300) us.push_back(static_cast<double>(now_ns() - t) * 1e-3);
+  }
+  int ok = 0;
+  for (auto& h : hands) ok += h.health() == LinkHealth::ok;
+  for (auto& a : arms) ok += a.health() == LinkHealth::ok;
+  std::printf("  control cycle: %d/4 links ok at the end, loop %s\n", ok, fifo ? "SCHED_FIFO 80" : "SCHED_OTHER");
+  set_fifo(0);
+  return us;
+}
+
+// The alternative: the least a user-space bus can cost per cycle. Four bare SEQPACKET
+// socketpairs, each with a peer thread blocked in poll() (so every send wakes it, as our
+// brokers are woken); per link one recv of a waiting frame and one send of two frames.
+std::vector<double> syscall_floor(int cycles) {
+  int sv[4][2];
+  for (auto& s : sv) ::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK, 0, s);
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> peers;
+  for (auto& s : sv) {
+    peers.emplace_back([&stop, fd = s[1]] {
+      CanFrame f;
+      while (!stop.load()) {
+        pollfd p{fd, POLLIN, 0};
+        if (::poll(&p, 1, 10) <= 0) continue;
+        while (::recv(fd, &f, sizeof(f), MSG_DONTWAIT) > 0) {
+        }
+        (void)!::send(fd, &f, sizeof(f), MSG_DONTWAIT);  // the "status" for the next cycle
+      }
+    });
+  }
+  std::vector<double> us;
+  CanFrame f[2];
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  for (int c = 0; c < cycles + 100; ++c) {
+    next.tv_nsec += 1'000'000;
+    if (next.tv_nsec >= 1'000'000'000) {
+      next.tv_nsec -= 1'000'000'000;
+      ++next.tv_sec;
+    }
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    const std::int64_t t = now_ns();
+    for (auto& s : sv) (void)!::recv(s[0], &f[0], sizeof(f[0]), MSG_DONTWAIT);
+    for (auto& s : sv) {
+      iovec iov[2] = {{&f[0], sizeof(CanFrame)}, {&f[1], sizeof(CanFrame)}};
+      mmsghdr m[2] = {};
+      for (int k = 0; k < 2; ++k) {
+        m[k].msg_hdr.msg_iov = &iov[k];
+        m[k].msg_hdr.msg_iovlen = 1;
+      }
+      (void)::sendmmsg(s[0], m, 2, MSG_DONTWAIT);
+    }
+    if (c >= 100) us.push_back(static_cast<double>(now_ns() - t) * 1e-3);
+  }
+  stop = true;
+  for (auto& p : peers) p.join();
+  for (auto& s : sv) {
+    ::close(s[0]);
+    ::close(s[1]);
+  }
+  return us;
+}
+
+double arg(int argc, char** argv, const char* name, double def) {
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::strcmp(argv[i], name) == 0) return std::atof(argv[i + 1]);
+  return def;
+}
+
+int run_bus(int argc, char** argv) {
+  const int n = static_cast<int>(arg(argc, argv, "--rtt", 20000));
+  const double seconds = arg(argc, argv, "--seconds", 5);
+  const int cycles = static_cast<int>(arg(argc, argv, "--cycles", 3000));
+
+  // Latency parts run under SCHED_FIFO where permitted (threads inherit it, the broker's too),
+  // ours and the alternative alike; the throughput part runs under SCHED_OTHER.
+  const bool fifo = set_fifo(80);
+  std::printf("scheduling: %s\n", fifo ? "SCHED_FIFO 80 for the latency measurements" : "SCHED_OTHER (no permission for SCHED_FIFO)");
+  const Pct ours = percentiles(mock_rtt(n));
+  const Pct alt = percentiles(socketpair_rtt(n));
+  set_fifo(0);
+  std::printf("round trip (us)        p50     p99   p99.9\n");
+  std::printf("  mock bus (broker) %7.1f %7.1f %7.1f\n", ours.p50, ours.p99, ours.p999);
+  std::printf("  bare socketpair   %7.1f %7.1f %7.1f   ratio p99 %.2f\n", alt.p50, alt.p99, alt.p999, ours.p99 / alt.p99);
+
+  const Throughput tp = throughput(seconds);
+  std::printf("sustained: %.0f frames/s over %.0f s, sent %llu received %llu lost %llu reordered %llu\n", tp.fps,
+              seconds, static_cast<unsigned long long>(tp.sent), static_cast<unsigned long long>(tp.received),
+              static_cast<unsigned long long>(tp.lost), static_cast<unsigned long long>(tp.reordered));
+  std::printf("  (a real 1 Mbit/s classic bus carries at most ~8,800 8-byte frames/s; the mock runs unpaced here)\n");
+
+  set_fifo(80);
+  const Pct sf = percentiles(serial_rtt(n / 4, true));
+  const Pct sr = percentiles(serial_rtt(n / 4, false));
+  set_fifo(0);
+  std::printf("pty round trip (us)    p50     p99   p99.9\n");
+  std::printf("  COBS+CRC frames   %7.1f %7.1f %7.1f\n", sf.p50, sf.p99, sf.p999);
+  std::printf("  raw bytes         %7.1f %7.1f %7.1f   ratio p99 %.2f\n", sr.p50, sr.p99, sr.p999, sf.p99 / sr.p99);
+
+  const Pct cy = percentiles(control_cycle(cycles));
+  set_fifo(80);
+  const Pct fl = percentiles(syscall_floor(cycles));
+  set_fifo(0);
+  std::printf("control cycle, 4 drivers (us) p50 p99 p99.9\n");
+  std::printf("  drivers           %7.1f %7.1f %7.1f\n", cy.p50, cy.p99, cy.p999);
+  std::printf("  bare socketpairs  %7.1f %7.1f %7.1f   ratio p99 %.2f\n", fl.p50, fl.p99, fl.p999, cy.p99 / fl.p99);
+  const bool clean = tp.lost == 0 && tp.reordered == 0;
+  std::printf("bus: rtt_p99_us=%.1f frames_per_s=%.0f serial_rtt_p99_us=%.1f cycle_p99_us=%.1f%s\n", ours.p99,
+              clean ? tp.fps : 0.0, sf.p99, cy.p99, clean ? "" : " (frames lost or reordered!)");
+  return clean ? 0 : 1;
+}
+}  // namespace
+
+CREASE_BENCH(bus, "mock CAN bus and pty serial round trips, throughput, 4-driver control cycle", run_bus);
