@@ -104,6 +104,7 @@ int Daemon::run() {
     if (step.applied) spdlog::info("{}: applied", step.what);
     else spdlog::warn("{}: not applied: {}", step.what, step.why);
   }
+  observer_ = std::make_unique<StateObserver>(host_->ports(), options_.record_state, facts_.start_ns);
   facts_.sched_fifo_applied &= any_fifo;
   facts_.affinity_applied &= any_cpu;
   spdlog::info("creased running: {} loops, {} plugins, control socket {}", config_.loops.size(), config_.plugins.size(),
@@ -158,6 +159,8 @@ int Daemon::run() {
   control::notify_stopping(stop_reason_);
   spdlog::info("stopping: {}", stop_reason_);
   server_->stop();
+  observer_->stop();  // takes the last model frame before outputs go safe
+  tracking_ = observer_->summary();
   host_->stop();  // drives every output safe, deactivates in reverse order
   host_->poll();
   print_summary();
@@ -176,6 +179,16 @@ void Daemon::print_progress(double t_s) {
     line += buf;
   }
   line += " faults " + std::to_string(host_->fault_count());
+  if (observer_) {
+    const TrackingSummary t = observer_->take_window();
+    tracking_ = t;
+    if (t.scored) {
+      char buf[160];
+      std::snprintf(buf, sizeof(buf), "; tracking error vs truth: %.2f mm (this second), %.2f mm (mean so far)",
+                    t.window_mean_mm, t.mean_mm);
+      line += buf;
+    }
+  }
   std::printf("%s\n", line.c_str());
   std::fflush(stdout);
 }
@@ -201,6 +214,15 @@ void Daemon::print_summary() const {
     }
   }
   std::printf("  faults: %llu\n", (unsigned long long)host_->fault_count());
+  if (tracking_.scored) {
+    std::printf("  tracking error of sheet_state vs sheet_truth: mean %.2f mm over %llu model frames, last %.2f mm, "
+                "worst %.2f mm\n",
+                tracking_.mean_mm, (unsigned long long)tracking_.frames, tracking_.last_mm, tracking_.max_mm);
+  }
+  if (!options_.record_state.empty()) {
+    std::printf("  recorded %llu model frames to %s (%llu not seen)\n", (unsigned long long)tracking_.recorded,
+                options_.record_state.c_str(), (unsigned long long)tracking_.missed);
+  }
   std::fflush(stdout);
 }
 

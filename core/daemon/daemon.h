@@ -13,6 +13,7 @@
 #include "core/config/daemon_config.h"
 #include "core/control/control_server.h"
 #include "core/daemon/report_builder.h"
+#include "core/daemon/state_observer.h"
 #include "core/plugin_host.h"
 
 namespace crease::daemon {
@@ -23,6 +24,7 @@ struct Options {
   std::optional<std::string> report_dir;  // overrides the configuration
   std::vector<std::string> plugin_dirs;   // when given, replace the configuration's
   bool progress = true;                   // a line per second on stdout
+  std::string record_state;               // write every model frame as JSON lines here
 };
 
 class Daemon final : public control::RequestHandler {
@@ -56,6 +58,8 @@ class Daemon final : public control::RequestHandler {
   Options options_;
   std::unique_ptr<PluginHost> host_;
   std::unique_ptr<control::ControlServer> server_;
+  std::unique_ptr<StateObserver> observer_;  // tracking error and --record-state
+  TrackingSummary tracking_;                 // final, after the observer stopped
   RunFacts facts_;
   std::atomic<bool> stop_{false};
   std::string stop_reason_ = "stopped";

@@ -1,6 +1,6 @@
 // creased: the Crease daemon.
 //   creased --config FILE [--socket PATH] [--duration SECONDS] [--report-dir DIR]
-//           [--log-level LEVEL] [--plugin-dir DIR]... [--no-progress]
+//           [--log-level LEVEL] [--plugin-dir DIR]... [--no-progress] [--record-state FILE]
 // Exit status: 0 after a clean stop, 2 for a configuration or plugin error (nothing started),
 // 1 for any other failure.
 #include <signal.h>
@@ -39,6 +39,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_option("--plugin-dir", options.plugin_dirs, "plugin directory (replaces the configuration's)");
   app.add_flag("--no-progress", no_progress, "no progress line every second");
+  app.add_option("--record-state", options.record_state,
+                 "write every sheet_state model frame as one JSON line to this file");
   CLI11_PARSE(app, argc, argv);
   if (!socket.empty()) options.socket = socket;
   if (duration > 0) options.duration_s = duration;

@@ -7,7 +7,7 @@
 // A step that leaves the state non-finite is rolled back to the last good state and the
 // update returns degraded (counted in sheet_state.rollbacks).
 // Parameters (all optional): nodes_u, nodes_v, width_mm, height_mm, density_g_per_m2,
-// thickness_mm, substeps, keypoint_gain_per_s, target_compliance_m_per_n,
+// thickness_mm, origin_x_mm, origin_y_mm, origin_z_mm, substeps, keypoint_gain_per_s, target_compliance_m_per_n,
 // compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
 // self_collision (0/1).
 #include <memory>
@@ -33,7 +33,9 @@ class SheetModelPlugin final : public Plugin {
     sp.grid.height_mm = p.get_in_range<double>("height_mm", 297.0, 10.0, 2000.0);
     sp.grid.areal_density_g_per_m2 = p.get_in_range<double>("density_g_per_m2", 80.0, 1.0, 1000.0);
     sp.grid.thickness_mm = p.get_in_range<double>("thickness_mm", 1.0, 0.01, 20.0);
-    sp.grid.origin_mm = {0.0, sp.grid.height_mm, 0.5 * sp.grid.thickness_mm};
+    // World position of sheet point (0,0) when flat (u -> +x, v -> -y).
+    sp.grid.origin_mm = {p.get<double>("origin_x_mm", 0.0), p.get<double>("origin_y_mm", sp.grid.height_mm),
+                         p.get<double>("origin_z_mm", 0.5 * sp.grid.thickness_mm)};
     sp.solver.substeps = p.get_in_range<int>("substeps", 10, 1, 100);
     sp.solver.keypoint_gain_per_s = p.get_in_range<double>("keypoint_gain_per_s", 10.0, 0.0, 1e6);
     sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);

@@ -34,7 +34,8 @@ bool SimSource::grab(Frame& frame) {
   RenderOptions o = options_;
   o.seed = options_.seed + next_;
   frame.index = next_;
-  frame.timestamp_ns = start_ns_ + static_cast<std::int64_t>(next_) * period_ns_;
+  // The scene's own time when it has one (a truth from the simulated world), else the nominal one.
+  frame.timestamp_ns = mesh.timestamp_ns >= 0 ? mesh.timestamp_ns : start_ns_ + static_cast<std::int64_t>(next_) * period_ns_;
   frame.images.resize(renderer_->cameras().size());
   for (std::size_t k = 0; k < frame.images.size(); ++k) {
     RenderedView v;  // fresh buffers: frame.images[k] keeps this one

@@ -4,6 +4,7 @@
 // (i,j)(i+1,j)(i,j+1) and (i+1,j)(i+1,j+1)(i,j+1), both with positive (u, v) orientation.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -14,6 +15,7 @@ struct SheetMesh {
   int nx = 0, ny = 0;           // nodes along u and v
   double w_mm = 0, h_mm = 0;    // sheet size
   std::vector<cv::Vec3d> nodes;  // world mm, size nx*ny, row by row
+  std::int64_t timestamp_ns = -1;  // CLOCK_MONOTONIC time the geometry is of; -1: unknown
 
   [[nodiscard]] cv::Vec3d node(int i, int j) const { return nodes[static_cast<std::size_t>(j * nx + i)]; }
   [[nodiscard]] cv::Point2d node_uv(int i, int j) const {

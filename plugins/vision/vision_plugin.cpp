@@ -13,11 +13,14 @@
 // Outputs: keypoints (crease::Keypoints). Status: degraded when a camera delivered nothing,
 // no new frame came for `stale_cycles` cycles, or a replay ended; fault if the worker failed.
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "core/plugin.h"
 #include "core/port_types/keypoints.h"
+#include "core/port_types/sheet_state.h"
+#include "rt/latest.h"
 #include "rt/clock.h"
 #include "marker_sheet.h"
 #include "vision_worker.h"
@@ -52,17 +55,42 @@ class VisionPlugin final : public crease::Plugin {
       ro.noise_sigma = p.get_in_range<double>("noise", 2.0, 0.0, 50.0);
       ro.blur_sigma_px = p.get_in_range<double>("blur_px", 0.6, 0.0, 5.0);
       ro.occluders = p.get_in_range<int>("occluders", 0, 0, 10);
-      // Built-in analytic half fold until the sheet_truth port exists (see README).
+      const std::string truth = p.get<std::string>("truth", "builtin");
+      // The sheet to render: `port` takes it from the `sheet_truth` port (the simulated world);
+      // `builtin` is an analytic half fold of its own (no other plugin needed).
       const double t0 = p.get_in_range<double>("fold_start_s", 1.0, 0.0, 1e6);
       const double dur = p.get_in_range<double>("fold_duration_s", 4.0, 0.01, 1e6);
       const double angle = p.get_in_range<double>("fold_angle_deg", 170.0, 0.0, 180.0) * CV_PI / 180.0;
       const double period_s = p.get_in_range<double>("frame_period_s", 1.0 / 30, 1e-3, 10.0);
       const SheetMesh flat = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0}, 0.1);
       const double h = layout.sheet_h_mm;
-      auto mesh_at = [=](std::uint64_t i) {
+      std::function<SheetMesh(std::uint64_t)> mesh_at = [=](std::uint64_t i) {
         const double s = std::clamp((double(i) * period_s - t0) / dur, 0.0, 1.0);
         return fold_sheet(flat, h / 2, angle * s);
       };
+      if (truth == "port") {
+        truth_in_ = ports.latest_input<crease::SheetState>("sheet_truth");
+        truth_buf_ = std::make_unique<crease::SheetState>();
+        truth_ch_ = std::make_shared<crease::rt::LatestChannel>(sizeof(crease::SheetState));
+        mesh_at = [ch = truth_ch_, buf = std::make_shared<crease::SheetState>(),
+                   fallback = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0}, 0.0)](std::uint64_t) {
+          // Worker thread: the newest truth the RT side handed over (flat until there is one).
+          if (!ch->read(buf.get(), 0).has_data() || buf->nodes_u < 2 || buf->nodes_v < 2) return fallback;
+          SheetMesh m;
+          m.nx = buf->nodes_u;
+          m.ny = buf->nodes_v;
+          m.w_mm = buf->width_mm;
+          m.h_mm = buf->height_mm;
+          m.timestamp_ns = buf->timestamp_ns;
+          m.nodes.resize(static_cast<std::size_t>(m.nx) * m.ny);
+          for (std::size_t k = 0; k < m.nodes.size(); ++k) {
+            m.nodes[k] = {buf->position_mm[k][0], buf->position_mm[k][1], buf->position_mm[k][2]};
+          }
+          return m;
+        };
+      } else if (truth != "builtin") {
+        p.fail("truth", "expected builtin or port, got '" + truth + "'");
+      }
       src = std::make_unique<SimSource>(renderer, mesh_at, ro, static_cast<std::int64_t>(period_s * 1e9),
                                         crease::rt::now_ns());
     } else if (source == "replay") {
@@ -84,6 +112,7 @@ class VisionPlugin final : public crease::Plugin {
   }
 
   crease::Status update(const crease::Cycle& cycle) override {
+    if (truth_in_.bound() && truth_in_.read(*truth_buf_).is_new()) truth_ch_->write(truth_buf_.get(), cycle.time_ns);
     switch (worker_->take_and_request_rt(*buf_)) {
       case VisionWorker::Take::fresh:
         out_.write(*buf_, cycle.time_ns);
@@ -106,6 +135,10 @@ class VisionPlugin final : public crease::Plugin {
   std::unique_ptr<VisionWorker> worker_;
   std::unique_ptr<crease::Keypoints> buf_;
   crease::LatestOutput<crease::Keypoints> out_;
+  // truth: port — the sheet_truth input, and the hand-over to the worker's renderer.
+  crease::LatestInput<crease::SheetState> truth_in_;
+  std::unique_ptr<crease::SheetState> truth_buf_;
+  std::shared_ptr<crease::rt::LatestChannel> truth_ch_;
   int stale_cycles_ = 10;
   int since_fresh_ = 0;
 };
