@@ -54,3 +54,12 @@ TEST_CASE("config/sim.yaml: every plugin's steady-state cycles allocate nothing"
     CHECK(i.stats->updates.load() > 0);
   }
 }
+
+TEST_CASE("config/robot.yaml validates (its plugins need the hardware to configure)") {
+  crease::config::LoadOptions o;
+  o.check_plugin_dirs_exist = false;
+  const auto cfg = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/robot.yaml", o);
+  CHECK(cfg.loops.size() == 3);
+  CHECK(cfg.find_plugin("hand_r") != nullptr);
+  CHECK(cfg.safety.on_fault == crease::config::FaultPolicy::stop);
+}
