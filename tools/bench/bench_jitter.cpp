@@ -1,4 +1,4 @@
-// crease-bench jitter [--seconds N] [--priority P] [--background-ms M]: wake-up latency of a
+// crease-bench jitter [--seconds N] [--priority P] [--background-ms M] [--chunks K] [--cpu C]: wake-up latency of a
 // Crease 1 kHz loop next to a busy background loop (15 Hz, burning M ms of CPU per cycle, like a
 // vision loop), then, in the same invocation and with the same background, cyclictest with the
 // same period and priority. Prints both distributions and their ratios.
@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 #include <thread>
+#include <memory>
 #include <vector>
 
 #include "bench_registry.h"
@@ -22,10 +23,10 @@ struct Dist {
 
 // Runs cyclictest for `seconds` and adds its -h histogram (one line "%06d %06lu" per
 // microsecond; overflows counted in the last slot) into `hist`.
-bool run_cyclictest(int priority, double seconds, std::vector<std::uint64_t>& hist, std::string& why) {
+bool run_cyclictest(int priority, int cpu, double seconds, std::vector<std::uint64_t>& hist, std::string& why) {
   const long loops = std::lround(seconds * 1000.0);
   const std::string cmd = "cyclictest -m -q -p " + std::to_string(priority) + " -i 1000 -l " + std::to_string(loops) +
-                          " -h 20000 2>&1";
+                          (cpu >= 0 ? " -a " + std::to_string(cpu) : std::string()) + " -h 20000 2>&1";
   FILE* f = popen(cmd.c_str(), "r");
   if (f == nullptr) {
     why = "cannot run cyclictest";
@@ -99,9 +100,14 @@ int run(int argc, char** argv) {
   const double background_ms = crease::bench::arg_double(argc, argv, "--background-ms", 50);
   // Crease and cyclictest take turns in chunks, so both meet the same machine noise.
   const int chunks = std::max(1, static_cast<int>(crease::bench::arg_double(argc, argv, "--chunks", 4)));
+  // --cpu N pins both Crease's loop and cyclictest (-a N) to one CPU; default: not pinned.
+  const int cpu = static_cast<int>(crease::bench::arg_double(argc, argv, "--cpu", -1));
   const double chunk_s = seconds / chunks;
 
   const auto mem = crease::rt::lock_memory(64u << 20);
+  // cyclictest holds /dev/cpu_dma_latency at 0 by default; Crease's loop gets the same
+  // (creased: daemon.cpu_dma_latency_us), released before cyclictest's turns.
+  auto dma = std::make_unique<crease::rt::DmaLatencyRequest>();
   std::printf("jitter: %s: %s %s\n", mem.what.c_str(), mem.applied ? "applied" : "not applied:", mem.why.c_str());
   crease::PluginHost background({CREASE_PLUGIN_DIR});
   background.add_loop({"vision", 15.0, 0, -1});
@@ -121,8 +127,14 @@ int run(int argc, char** argv) {
   std::vector<std::uint64_t> ct_hist;
   for (int c = 0; c < chunks; ++c) {
     {
+      dma = std::make_unique<crease::rt::DmaLatencyRequest>();
+      const auto dma_step = dma->request(0);
+      if (c == 0) {
+        std::printf("jitter: %s: %s %s\n", dma_step.what.c_str(), dma_step.applied ? "applied" : "not applied:",
+                    dma_step.why.c_str());
+      }
       crease::PluginHost host({CREASE_PLUGIN_DIR});
-      host.add_loop({"control", 1000.0, priority, -1});
+      host.add_loop({"control", 1000.0, priority, cpu});
       host.add_instance(instance("noop", "crease_test_noop", "control", "{}"));
       const auto steps = host.start();
       if (c == 0) {
@@ -136,8 +148,9 @@ int run(int argc, char** argv) {
       overruns += control->timing().overruns.load();
       cycles += control->timing().cycles.load();
       host.stop();
+      dma.reset();
     }
-    if (have_ct) have_ct = run_cyclictest(priority, chunk_s, ct_hist, why);
+    if (have_ct) have_ct = run_cyclictest(priority, cpu, chunk_s, ct_hist, why);
   }
   background.stop();
 
