@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <bit>
 #include <cstdlib>
+#include <limits>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 namespace crease::sheet {
 namespace {
@@ -10,20 +16,73 @@ namespace {
 constexpr int kMaxContactsPerNode = 4;
 constexpr double kBaryTolerance = 0.05;  // accept projections slightly outside a triangle
 
-// Barycentric coordinates of p's projection onto the plane of (a, b, c).
-bool barycentric(Vec3 p, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
-  const Vec3 e0 = b - a, e1 = c - a, ep = p - a;
-  const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1);
-  const double d20 = dot(ep, e0), d21 = dot(ep, e1);
-  const double den = d00 * d11 - d01 * d01;
-  if (!(den > 1e-12)) return false;
-  const double v = (d11 * d20 - d01 * d21) / den;
-  const double w = (d00 * d21 - d01 * d20) / den;
-  out[0] = 1.0 - v - w;
-  out[1] = v;
-  out[2] = w;
+// Barycentric coordinates of p's projection onto the plane of (a, b, c), from the signed
+// areas: n = (b - a) x (c - a), nn = |n|^2 > 0. True when inside (with tolerance).
+bool barycentric(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3 n, double nn, double out[3]) {
+  const double inv = 1.0 / nn;
+  const Vec3 pa = a - p, pb = b - p, pc = c - p;
+  out[0] = dot(cross(pb, pc), n) * inv;
+  out[1] = dot(cross(pc, pa), n) * inv;
+  out[2] = 1.0 - out[0] - out[1];
   return out[0] >= -kBaryTolerance && out[1] >= -kBaryTolerance && out[2] >= -kBaryTolerance;
 }
+
+constexpr double kMinArea2 = 1e-12;  // mm^4: |n|^2 of a degenerate triangle
+
+// Node screening for one pair of triangles: a float box, and the grid box of nodes that are
+// sheet neighbours of both. Arrays are padded to whole blocks of kScreenBlock nodes.
+constexpr int kScreenBlock = 32;
+struct Screen {
+  float lo[3], hi[3];
+  std::int32_t ni0, ni1, nj0, nj1;
+};
+struct ScreenNodes {
+  const float *x, *y, *z;
+  const std::int32_t *gi, *gj;
+};
+
+// Bit e: node base + e is inside the box and not in the neighbour box.
+std::uint32_t screen_scalar(const Screen& sc, const ScreenNodes& nd, int base) noexcept {
+  std::uint32_t mask = 0;
+  for (int e = 0; e < kScreenBlock; ++e) {
+    const int p = base + e;
+    const bool inside = nd.x[p] >= sc.lo[0] && nd.x[p] <= sc.hi[0] && nd.y[p] >= sc.lo[1] && nd.y[p] <= sc.hi[1] &&
+                        nd.z[p] >= sc.lo[2] && nd.z[p] <= sc.hi[2];
+    const bool near = nd.gi[p] >= sc.ni0 && nd.gi[p] <= sc.ni1 && nd.gj[p] >= sc.nj0 && nd.gj[p] <= sc.nj1;
+    if (inside && !near) mask |= std::uint32_t{1} << e;
+  }
+  return mask;
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx2"))) std::uint32_t screen_avx2(const Screen& sc, const ScreenNodes& nd, int base) noexcept {
+  std::uint32_t mask = 0;
+  for (int h = 0; h < kScreenBlock; h += 8) {
+    const int p = base + h;
+    const __m256 px = _mm256_loadu_ps(nd.x + p), py = _mm256_loadu_ps(nd.y + p), pz = _mm256_loadu_ps(nd.z + p);
+    __m256 in = _mm256_and_ps(_mm256_cmp_ps(px, _mm256_set1_ps(sc.lo[0]), _CMP_GE_OQ),
+                              _mm256_cmp_ps(px, _mm256_set1_ps(sc.hi[0]), _CMP_LE_OQ));
+    in = _mm256_and_ps(in, _mm256_cmp_ps(py, _mm256_set1_ps(sc.lo[1]), _CMP_GE_OQ));
+    in = _mm256_and_ps(in, _mm256_cmp_ps(py, _mm256_set1_ps(sc.hi[1]), _CMP_LE_OQ));
+    in = _mm256_and_ps(in, _mm256_cmp_ps(pz, _mm256_set1_ps(sc.lo[2]), _CMP_GE_OQ));
+    in = _mm256_and_ps(in, _mm256_cmp_ps(pz, _mm256_set1_ps(sc.hi[2]), _CMP_LE_OQ));
+    const auto inside = static_cast<std::uint32_t>(_mm256_movemask_ps(in));
+    if (inside == 0) continue;
+    const __m256i gi = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(nd.gi + p));
+    const __m256i gj = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(nd.gj + p));
+    // near: ni0 <= gi <= ni1 and nj0 <= gj <= nj1, as ni0 - 1 < gi < ni1 + 1 and likewise
+    __m256i nr = _mm256_and_si256(_mm256_cmpgt_epi32(gi, _mm256_set1_epi32(sc.ni0 - 1)),
+                                  _mm256_cmpgt_epi32(_mm256_set1_epi32(sc.ni1 + 1), gi));
+    nr = _mm256_and_si256(nr, _mm256_cmpgt_epi32(gj, _mm256_set1_epi32(sc.nj0 - 1)));
+    nr = _mm256_and_si256(nr, _mm256_cmpgt_epi32(_mm256_set1_epi32(sc.nj1 + 1), gj));
+    const auto near = static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(nr)));
+    mask |= (inside & ~near & 0xFFu) << h;
+  }
+  return mask;
+}
+#else
+std::uint32_t screen_avx2(const Screen& sc, const ScreenNodes& nd, int base) noexcept { return screen_scalar(sc, nd, base); }
+#endif
 
 }  // namespace
 
@@ -36,21 +95,30 @@ void ContactSolver::configure(const Topology& topo, const GridParams& grid, cons
   const int n = topo.grid.count();
   shape_pairs_.resize(static_cast<std::size_t>(n) * kMaxContactsPerNode);
   self_pairs_.resize(static_cast<std::size_t>(n) * 8);
-  std::uint32_t buckets = 1;
-  while (buckets < 2u * static_cast<std::uint32_t>(n)) buckets <<= 1;
-  bucket_mask_ = buckets - 1;
-  bucket_start_.assign(buckets + 1, 0);
-  bucket_items_.assign(n, 0);
-  node_cell_.assign(n, 0);
-  node_ijk_.assign(static_cast<std::size_t>(n) * 3, 0);
+  node_gi_.resize(n);
+  node_gj_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    node_gi_[i] = i % topo.grid.w;
+    node_gj_[i] = i / topo.grid.w;
+  }
+  // Screening arrays padded to whole blocks; padding nodes never pass (NaN positions).
+  const std::size_t padded = static_cast<std::size_t>((n + kScreenBlock - 1) / kScreenBlock * kScreenBlock);
+  fx_.assign(padded, std::numeric_limits<float>::quiet_NaN());
+  fy_.assign(padded, std::numeric_limits<float>::quiet_NaN());
+  fz_.assign(padded, std::numeric_limits<float>::quiet_NaN());
+  block_box_.assign(padded / kScreenBlock * 6, 0.0f);
+  gi_.assign(padded, 0);
+  gj_.assign(padded, 0);
+  for (int i = 0; i < n; ++i) {
+    gi_[i] = node_gi_[i];
+    gj_[i] = node_gj_[i];
+  }
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_cpu_init();
+  has_simd_ = __builtin_cpu_supports("avx2");
+#endif
+  use_simd_ = has_simd_;
   cell_mm_ = std::hypot(topo.grid.du, topo.grid.dv) + 2.0 * thickness_;
-}
-
-std::uint32_t ContactSolver::cell_hash(int cx, int cy, int cz) const noexcept {
-  const std::uint32_t h = static_cast<std::uint32_t>(cx) * 73856093u ^
-                          static_cast<std::uint32_t>(cy) * 19349663u ^
-                          static_cast<std::uint32_t>(cz) * 83492791u;
-  return h & bucket_mask_;
 }
 
 void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* world, double margin_mm) noexcept {
@@ -78,65 +146,141 @@ void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* wor
 void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) noexcept {
   const int n = static_cast<int>(x.size());
   const double inv_cell = 1.0 / cell_mm_;
-  auto cell_of = [inv_cell](double c) { return static_cast<int>(std::floor(c * inv_cell)); };
-  // Counting sort of nodes into hash buckets.
-  std::fill(bucket_start_.begin(), bucket_start_.end(), 0u);
-  for (int i = 0; i < n; ++i) {
-    std::int32_t* c = &node_ijk_[3 * static_cast<std::size_t>(i)];
-    c[0] = cell_of(x[i].x);
-    c[1] = cell_of(x[i].y);
-    c[2] = cell_of(x[i].z);
-    node_cell_[i] = cell_hash(c[0], c[1], c[2]);
-    ++bucket_start_[node_cell_[i] + 1];
+  auto cell_of = [inv_cell](double c) {  // floor without a libm call, clamped (NaN too) to +-1e9
+    double s = c * inv_cell;
+    if (!(s > -1e9)) s = -1e9;
+    if (!(s < 1e9)) s = 1e9;
+    const int i = static_cast<int>(s);
+    return i - (s < static_cast<double>(i) ? 1 : 0);
+  };
+  // Float copies for screening, and each block's box (blocks far from a triangle are skipped).
+  const int blocks = (n + kScreenBlock - 1) / kScreenBlock;
+  for (int k = 0; k < blocks; ++k) {
+    float* bb = &block_box_[6 * static_cast<std::size_t>(k)];
+    bb[0] = bb[1] = bb[2] = std::numeric_limits<float>::max();
+    bb[3] = bb[4] = bb[5] = std::numeric_limits<float>::lowest();
+    for (int i = k * kScreenBlock; i < std::min(n, (k + 1) * kScreenBlock); ++i) {
+      fx_[i] = static_cast<float>(x[i].x);
+      fy_[i] = static_cast<float>(x[i].y);
+      fz_[i] = static_cast<float>(x[i].z);
+      bb[0] = std::min(bb[0], fx_[i]);
+      bb[1] = std::min(bb[1], fy_[i]);
+      bb[2] = std::min(bb[2], fz_[i]);
+      bb[3] = std::max(bb[3], fx_[i]);
+      bb[4] = std::max(bb[4], fy_[i]);
+      bb[5] = std::max(bb[5], fz_[i]);
+    }
   }
-  for (std::size_t b = 1; b < bucket_start_.size(); ++b) bucket_start_[b] += bucket_start_[b - 1];
-  // bucket_start_[b] is now the start of bucket b; fill using a moving cursor in bucket_start_[b+1]-..
-  for (int i = 0; i < n; ++i) bucket_items_[bucket_start_[node_cell_[i]]++] = i;
-  // Shift back: after filling, bucket_start_[b] is the end of bucket b == start of b+1.
-  for (std::size_t b = bucket_start_.size() - 1; b > 0; --b) bucket_start_[b] = bucket_start_[b - 1];
-  bucket_start_[0] = 0;
-
   const double reach = thickness_ + margin_mm;
   const auto& tri = topo_->tri;
   const int nt = topo_->triangle_count();
-  const int gw = topo_->grid.w;
-  for (int t = 0; t < nt; ++t) {
-    const int ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
-    const int ti = ia % gw, tj = ia / gw;  // the triangle's first corner in the grid
-    const Vec3 a = x[ia], b = x[ib], c = x[ic];
-    const Vec3 nrm = normalized(cross(b - a, c - a));
-    const int x0 = cell_of(std::min({a.x, b.x, c.x}) - reach), x1 = cell_of(std::max({a.x, b.x, c.x}) + reach);
-    const int y0 = cell_of(std::min({a.y, b.y, c.y}) - reach), y1 = cell_of(std::max({a.y, b.y, c.y}) + reach);
-    const int z0 = cell_of(std::min({a.z, b.z, c.z}) - reach), z1 = cell_of(std::max({a.z, b.z, c.z}) + reach);
-    if ((x1 - x0) > 3 || (y1 - y0) > 3 || (z1 - z0) > 3) continue;  // torn / degenerate triangle
-    for (int cx = x0; cx <= x1; ++cx) {
-      for (int cy = y0; cy <= y1; ++cy) {
-        for (int cz = z0; cz <= z1; ++cz) {
-          const std::uint32_t h = cell_hash(cx, cy, cz);
-          for (std::uint32_t s = bucket_start_[h]; s < bucket_start_[h + 1]; ++s) {
-            const int p = bucket_items_[s];
-            // Each node sits in one cell: visit it only from that cell (no duplicates).
-            const std::int32_t* pc = &node_ijk_[3 * static_cast<std::size_t>(p)];
-            if (pc[0] != cx || pc[1] != cy || pc[2] != cz) continue;
-            if (std::abs(p % gw - ti) <= kSelfSkipCells + 1 && std::abs(p / gw - tj) <= kSelfSkipCells + 1)
-              continue;  // same layer, near in the sheet (incident nodes included)
-            const double d = dot(x[p] - a, nrm);
-            if (std::fabs(d) >= reach) continue;
-            double bary[3];
-            if (!barycentric(x[p], a, b, c, bary)) continue;
-            if (n_self_ >= static_cast<int>(self_pairs_.size())) {
-              ++stats_.dropped;
-              continue;
-            }
-            self_pairs_[n_self_++] = {p, t, d >= 0 ? 1.0 : -1.0};
+  // The two triangles of a grid cell are consecutive: the nodes are screened once per pair
+  // (set up lazily: most pairs have no candidate), each candidate tested against both.
+  struct Tri {
+    int t, ti, tj;  // index; the grid column / row of its first corner
+    Vec3 a, b, c, n, nrm;
+    double nn;
+    double bl[3], bh[3];  // its box grown by reach and by the barycentric tolerance
+  };
+  constexpr int r = kSelfSkipCells + 1;
+  const ScreenNodes nd{fx_.data(), fy_.data(), fz_.data(), gi_.data(), gj_.data()};
+  for (int t0 = 0; t0 < nt; t0 += 2) {
+    const int t1 = std::min(t0 + 2, nt);
+    // Screen with a box holding both triangles' grown boxes (the pair's extent is at least
+    // each one's), grown a little more for float rounding, and the grid box of nodes that
+    // are sheet neighbours of both.
+    double mn[3] = {1e300, 1e300, 1e300}, mx[3] = {-1e300, -1e300, -1e300};
+    Screen sc{{0, 0, 0}, {0, 0, 0}, -(1 << 30), 1 << 30, -(1 << 30), 1 << 30};
+    for (int t = t0; t < t1; ++t) {
+      for (int v = 0; v < 3; ++v) {
+        const Vec3 p = x[tri[3 * t + v]];
+        mn[0] = std::min(mn[0], p.x);
+        mn[1] = std::min(mn[1], p.y);
+        mn[2] = std::min(mn[2], p.z);
+        mx[0] = std::max(mx[0], p.x);
+        mx[1] = std::max(mx[1], p.y);
+        mx[2] = std::max(mx[2], p.z);
+      }
+      const int first = tri[3 * t];
+      sc.ni0 = std::max(sc.ni0, node_gi_[first] - r);
+      sc.ni1 = std::min(sc.ni1, node_gi_[first] + r);
+      sc.nj0 = std::max(sc.nj0, node_gj_[first] - r);
+      sc.nj1 = std::min(sc.nj1, node_gj_[first] + r);
+    }
+    for (int e = 0; e < 3; ++e) {
+      const double grow = reach + 2.0 * kBaryTolerance * (mx[e] - mn[e]) + 1e-9;
+      const double lo = mn[e] - grow, hi = mx[e] + grow;
+      sc.lo[e] = static_cast<float>(lo - 1e-3 * (1.0 + std::fabs(lo)));
+      sc.hi[e] = static_cast<float>(hi + 1e-3 * (1.0 + std::fabs(hi)));
+    }
+    Tri g[2];
+    int ng = -1;  // set up on the first candidate
+    for (int base = 0; base < n; base += kScreenBlock) {
+      const float* bb = &block_box_[6 * static_cast<std::size_t>(base / kScreenBlock)];
+      if (bb[3] < sc.lo[0] || bb[0] > sc.hi[0] || bb[4] < sc.lo[1] || bb[1] > sc.hi[1] || bb[5] < sc.lo[2] ||
+          bb[2] > sc.hi[2])
+        continue;
+      std::uint32_t mask = use_simd_ ? screen_avx2(sc, nd, base) : screen_scalar(sc, nd, base);
+      if (mask != 0 && ng < 0) {
+        ng = 0;
+        for (int t = t0; t < t1; ++t) {
+          Tri& q = g[ng];
+          const int ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+          q.t = t;
+          q.ti = node_gi_[ia];
+          q.tj = node_gj_[ia];
+          q.a = x[ia];
+          q.b = x[ib];
+          q.c = x[ic];
+          q.n = cross(q.b - q.a, q.c - q.a);
+          q.nn = dot(q.n, q.n);
+          if (!(q.nn > kMinArea2)) continue;  // degenerate: no projection
+          q.nrm = (1.0 / std::sqrt(q.nn)) * q.n;
+          const double tmn[3] = {std::min({q.a.x, q.b.x, q.c.x}), std::min({q.a.y, q.b.y, q.c.y}),
+                                 std::min({q.a.z, q.b.z, q.c.z})};
+          const double tmx[3] = {std::max({q.a.x, q.b.x, q.c.x}), std::max({q.a.y, q.b.y, q.c.y}),
+                                 std::max({q.a.z, q.b.z, q.c.z})};
+          bool torn = false;
+          for (int e = 0; e < 3; ++e) {
+            torn = torn || cell_of(tmx[e] + reach) - cell_of(tmn[e] - reach) > 3;
+            // A projection accepted by barycentric() lies within 2 kBaryTolerance of the
+            // extent outside the box: nodes outside bl..bh cannot pass both tests below.
+            const double grow = reach + 2.0 * kBaryTolerance * (tmx[e] - tmn[e]) + 1e-9;
+            q.bl[e] = tmn[e] - grow;
+            q.bh[e] = tmx[e] + grow;
           }
+          if (!torn) ++ng;  // torn / degenerate triangle: skipped
+        }
+      }
+      while (mask != 0) {
+        const int p = base + std::countr_zero(mask);
+        mask &= mask - 1;
+        if (p >= n) break;
+        const Vec3 xp = x[p];
+        for (int k = 0; k < ng; ++k) {
+          const Tri& q = g[k];
+          if (std::abs(node_gi_[p] - q.ti) <= r && std::abs(node_gj_[p] - q.tj) <= r)
+            continue;  // same layer, near in the sheet (incident nodes included)
+          if (xp.x < q.bl[0] || xp.x > q.bh[0] || xp.y < q.bl[1] || xp.y > q.bh[1] || xp.z < q.bl[2] ||
+              xp.z > q.bh[2])
+            continue;
+          const double d = dot(xp - q.a, q.nrm);
+          if (std::fabs(d) >= reach) continue;
+          double bary[3];
+          if (!barycentric(xp, q.a, q.b, q.c, q.n, q.nn, bary)) continue;
+          if (n_self_ >= static_cast<int>(self_pairs_.size())) {
+            ++stats_.dropped;
+            continue;
+          }
+          self_pairs_[n_self_++] = {p, q.t, d >= 0 ? 1.0 : -1.0};
         }
       }
     }
   }
 }
 
-void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w) noexcept {
+void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w,
+                             bool with_self) noexcept {
   // Nodes against rigid shapes: push out to half the thickness, then Coulomb friction on
   // the substep's tangential displacement.
   for (int k = 0; k < n_shape_; ++k) {
@@ -148,25 +292,32 @@ void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std:
     p += pen * c.normal;
     Vec3 dt = p - prev[c.node];
     dt -= dot(dt, c.normal) * c.normal;
-    const double slide = norm(dt);
-    if (slide <= friction_ * pen) {
+    const double slide2 = dot(dt, dt), stick = friction_ * pen;
+    if (slide2 <= stick * stick) {
       p -= dt;
-    } else if (slide > 0) {
-      p -= (friction_ * pen / slide) * dt;
+    } else if (slide2 > 0) {
+      p -= (stick / std::sqrt(slide2)) * dt;
     }
   }
+  if (!with_self) return;
   // Nodes against triangles of other layers: keep the frame's side, thickness apart.
   const auto& tri = topo_->tri;
   for (int k = 0; k < n_self_; ++k) {
     const SelfPair& c = self_pairs_[k];
     const int ia = tri[3 * c.tri], ib = tri[3 * c.tri + 1], ic = tri[3 * c.tri + 2];
     const Vec3 a = x[ia], b = x[ib], cc = x[ic];
-    const Vec3 nrm = normalized(cross(b - a, cc - a));
+    const Vec3 n = cross(b - a, cc - a);
+    const double nn = dot(n, n);
+    if (!(nn > kMinArea2)) continue;
+    // d = side * dot(x - q, n / |n|) with q the projection (so dot(x - a, n) / |n|);
+    // most pairs are apart: test d >= thickness without a square root first.
+    const double sd = c.side * dot(x[c.node] - a, n);
+    if (sd >= 0 && sd * sd >= thickness_ * thickness_ * nn) continue;
     double bary[3];
-    if (!barycentric(x[c.node], a, b, cc, bary)) continue;
-    const Vec3 q = bary[0] * a + bary[1] * b + bary[2] * cc;
-    const double d = c.side * dot(x[c.node] - q, nrm);
-    if (d >= thickness_) continue;
+    if (!barycentric(x[c.node], a, b, cc, n, nn, bary)) continue;
+    const double inv_len = 1.0 / std::sqrt(nn);
+    const double d = sd * inv_len;
+    const Vec3 nrm = inv_len * n;
     const double wsum = w[c.node] + bary[0] * bary[0] * w[ia] + bary[1] * bary[1] * w[ib] +
                         bary[2] * bary[2] * w[ic];
     if (wsum <= 0) continue;

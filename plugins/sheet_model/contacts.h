@@ -1,10 +1,15 @@
 // Contact constraints of the sheet: nodes against rigid shapes (found by ODE's collision
 // detection once per frame, enforced every substep with Coulomb friction) and nodes
-// against triangles of other layers (a spatial hash once per frame; each node keeps the
-// side it started the frame on, at least `thickness` away, so layers never pass through
-// each other). Nodes within kSelfSkipCells grid cells of a triangle are not tested against
-// it: a sheet cannot fold onto itself that tightly at this resolution, and skipping them
-// keeps curved (unfolded) regions free of spurious contacts.
+// against triangles of other layers (found once per frame; each node keeps the side it
+// started the frame on, at least `thickness` away, so layers never pass through each
+// other). Nodes within kSelfSkipCells + 1 grid cells of a triangle's first corner are not
+// tested against it: a sheet cannot fold onto itself that tightly at this resolution, and
+// skipping them keeps curved (unfolded) regions free of spurious contacts.
+// Detection, per grid cell (its two triangles share a box): blocks of 32 nodes whose box
+// misses the cell's box grown by the reach are skipped, the rest are screened 8 at a time
+// (AVX2 when the CPU has it) against that box and the sheet-neighbour rule, and the few
+// survivors get the exact tests (plane distance, barycentric projection). The cost grows
+// with cells x blocks: fine for the default 15 x 21 sheet and a few times larger.
 #pragma once
 
 #include <cstdint>
@@ -31,10 +36,14 @@ class ContactSolver {
 
   // Once per frame, before the substeps. margin_mm: how far a node may move in the frame.
   void detect_rt(std::span<const Vec3> x, const CollisionWorld* world, double margin_mm) noexcept;
-  // Every substep, after the links. w: inverse masses (0 = pinned).
-  void solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w) noexcept;
+  // Every substep, after the links. w: inverse masses (0 = pinned). with_self: also the
+  // layer contacts (else only the rigid shapes).
+  void solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w,
+                bool with_self = true) noexcept;
 
   [[nodiscard]] const ContactStats& stats() const noexcept { return stats_; }
+  // Screens nodes without AVX2 even when the CPU has it (tests compare the two).
+  void force_scalar(bool on) noexcept { use_simd_ = has_simd_ && !on; }
 
  private:
   struct ShapePair {
@@ -48,26 +57,21 @@ class ContactSolver {
   };
 
   void detect_self_rt(std::span<const Vec3> x, double margin_mm) noexcept;
-  [[nodiscard]] std::uint32_t cell_hash(int cx, int cy, int cz) const noexcept;
 
   const Topology* topo_ = nullptr;
   double half_thickness_ = 0.5, thickness_ = 1.0, friction_ = 0.5;
   bool self_enabled_ = true;
+  bool has_simd_ = false, use_simd_ = false;  // AVX2 node screening (runtime check)
   std::vector<ShapePair> shape_pairs_;
   int n_shape_ = 0;
   std::vector<SelfPair> self_pairs_;
   int n_self_ = 0;
-  // Spatial hash of triangles: counting sort into buckets (cell size ~ node spacing).
-  double cell_mm_ = 20.0;
-  std::uint32_t bucket_mask_ = 0;
-  std::vector<std::uint32_t> bucket_start_;  // size buckets + 1
-  std::vector<std::int32_t> bucket_items_;
-  std::vector<std::uint32_t> tri_cells_;     // per triangle: hashed cells (up to kCellsPerTri)
-  std::vector<std::uint8_t> tri_cell_count_;
-  std::vector<std::uint32_t> node_cell_;    // hash bucket of each node
-  std::vector<std::int32_t> node_ijk_;      // integer cell of each node (3 per node)
+  double cell_mm_ = 20.0;  // a triangle whose box grown by the reach spans > 3 cells is torn
+  std::vector<std::int32_t> node_gi_, node_gj_;  // grid column / row of each node
+  std::vector<float> fx_, fy_, fz_;              // node positions for screening (padded)
+  std::vector<std::int32_t> gi_, gj_;            // node_gi_ / node_gj_ padded
+  std::vector<float> block_box_;                 // per block of screened nodes: min xyz, max xyz
   ContactStats stats_;
-  static constexpr int kCellsPerTri = 8;
   static constexpr int kSelfSkipCells = 2;
 };
 

@@ -1,23 +1,81 @@
-// The XPBD inner loop over links (seed 001 Eqs. 2-3, lambda = 0 per substep), on links
-// packed structure-of-arrays in colour order: within a colour no two links share a node, so
-// consecutive projections are independent and the CPU overlaps them (measured 2026-11-21 on
-// the CI kind of machine: 4-5x faster than link order; an AVX2 gather/scatter version of
-// this loop was no faster in the solver and was dropped).
+// The XPBD inner loop over links (seed 001 Eqs. 2-3, lambda = 0 per substep), the hot path.
+//
+// Layout: node positions are copied into float structure-of-arrays over a padded grid
+// (row stride S >= W, a multiple of 8), so node (i, j) sits at j*S + i. Links are grouped
+// by their grid offset: all links from node p to node p + D (D > 0 in padded indices) form
+// one batch of consecutive "lanes", lane p <-> link (p, p + D). Lanes without a link carry
+// zero weights and change nothing. When D >= w, any w consecutive lanes touch 2w distinct
+// nodes, so they are projected at once with contiguous loads and stores (no gather, no
+// colouring): w = 16 with AVX-512 (D >= 16), 8 with AVX2+FMA (D >= 8), chosen by a
+// runtime CPU check; the batch is swept block by block, which is one Gauss-Seidel order.
+// Links whose row-major D is short (along a row, or D < 16 with AVX-512) go to a second,
+// transposed layout (node (i, j) at i*S' + j, S' >= H) when their offset is wider there:
+// the pass runs the row-major batches, copies the positions across, then runs the
+// transposed ones. Links that fit neither run lane by lane, as does every batch on a CPU
+// without AVX2+FMA (same order). A topology that repeats an offset/pair gets extra batches.
+//
+// Configure-time: configure(). RT: everything else (no allocation).
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
+
+#include "topology.h"
+#include "vec3.h"
 
 namespace crease::sheet {
 
-struct PackedLinks {
-  std::vector<std::int32_t> a, b;  // node indices
-  std::vector<double> rest;        // l + dl_p, mm
-  std::vector<double> wa, wb;      // w_a / (w_a + w_b + alpha / dt_s^2), likewise b
-  [[nodiscard]] int size() const noexcept { return static_cast<int>(a.size()); }
-};
+class LinkKernel {
+ public:
+  // Builds the padded layout and batches for topo's links (allocates). max_simd_width (16,
+  // 8) caps the block width below what the CPU offers (tests of the AVX2 path).
+  void configure(const Topology& topo, int max_simd_width = 16);
 
-// One Gauss-Seidel pass. x: node positions as x0 y0 z0 x1 y1 z1 ... RT.
-void project_links_rt(const PackedLinks& links, double* x) noexcept;
+  // Per-link data. wa, wb: w_a / (w_a + w_b + alpha / dt_s^2) for topo.a[link] and
+  // topo.b[link] (likewise b); rest: l + dl_p, mm. RT.
+  void set_link(int link, double rest_mm, double wa, double wb) noexcept;
+  void set_rest(int link, double rest_mm) noexcept { rest_[lane_[link]] = static_cast<float>(rest_mm); }
+
+  // Copies positions in; one Gauss-Seidel pass over every link; adds the moves back
+  // (x += new - old in float, so nodes no link moved keep their exact double value). RT.
+  void project_rt(std::span<Vec3> x) noexcept;
+
+  // false: the lane-by-lane path (no AVX2+FMA on this CPU, or forced for tests).
+  [[nodiscard]] bool vectorized() const noexcept { return use_simd_; }
+  [[nodiscard]] int max_width() const noexcept { return use_simd_ ? (has_avx512_ ? 16 : 8) : 1; }
+  void force_scalar(bool on) noexcept;
+  [[nodiscard]] int batch_count() const noexcept {
+    return static_cast<int>(lay_[0].batches.size() + lay_[1].batches.size());
+  }
+  [[nodiscard]] int lane_count() const noexcept { return static_cast<int>(rest_.size()); }
+
+  struct Batch {
+    std::int32_t a0;     // padded index of lane 0's a-node
+    std::int32_t d;      // b-node = a-node + d
+    std::int32_t lanes;  // a multiple of 8
+    std::int32_t data;   // first lane's slot in rest_/wa_/wb_
+    std::int32_t width;  // lanes per block: 16 (AVX-512, d >= 16), 8 (AVX2, d >= 8) or 1
+    std::int32_t step;   // blocks are visited r, r+step, r+2 step, ... for r < step
+  };
+
+ private:
+  struct Layout {
+    int stride = 0;
+    bool transposed = false;
+    std::vector<Batch> batches;
+    std::vector<float> px, py, pz;  // padded positions
+    [[nodiscard]] int index(int i, int j) const noexcept { return transposed ? i * stride + j : j * stride + i; }
+  };
+  void run(Layout& lay) noexcept;
+
+  int w_ = 0, h_ = 0;
+  bool use_simd_ = false, has_avx2_ = false, has_avx512_ = false;
+  Layout lay_[2];                       // row-major, transposed
+  std::vector<std::int32_t> lane_;      // per link: its lane slot
+  std::vector<std::uint8_t> flipped_;   // per link: 1 when topo.a is the lane's b-node
+  std::vector<float> rest_, wa_, wb_;   // per lane slot
+  std::vector<float> ox_, oy_, oz_;     // per node: the values copied in
+};
 
 }  // namespace crease::sheet

@@ -192,12 +192,15 @@ int SheetModel::set_targets(std::span<const TargetPoint> t) noexcept {
 
 void SheetModel::pin(int node, Vec3 world_mm) noexcept {
   if (node < 0 || node >= node_count() || !is_finite(world_mm)) return;
+  if (pinned_[node] == 0) ++links_version_;  // inverse masses change
   pinned_[node] = 1;
   pin_pos_[node] = world_mm;
 }
 
 void SheetModel::unpin(int node) noexcept {
-  if (node >= 0 && node < node_count()) pinned_[node] = 0;
+  if (node < 0 || node >= node_count() || pinned_[node] == 0) return;
+  pinned_[node] = 0;
+  ++links_version_;  // inverse masses change
 }
 
 void SheetModel::compute_normals(std::span<Vec3> out) const noexcept {

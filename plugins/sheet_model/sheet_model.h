@@ -106,7 +106,8 @@ class SheetModel {
   // Per-link strain (|x_b - x_a| - rest) / rest. RT.
   void compute_strains(std::span<double> out) const noexcept;
   [[nodiscard]] bool state_finite() const noexcept;
-  // Incremented whenever rest lengths or stiffnesses change (backends re-read them).
+  // Incremented whenever rest lengths, stiffnesses or the set of pinned nodes change
+  // (backends re-read them).
   [[nodiscard]] std::uint64_t links_version() const noexcept { return links_version_; }
 
  protected:

@@ -51,6 +51,9 @@ struct SolverParams {
   // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
   double friction = 0.5;
   bool self_collision = true;
+  // Layer contacts are enforced every this many substeps and always on the last one (a node
+  // keeps its side for the whole frame, so one skipped substep cannot lose it).
+  int self_collision_every = 2;
 };
 
 struct SheetParams {

@@ -15,35 +15,12 @@ XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
   kvel_.assign(n, Vec3{});
   kweight_.assign(n, 0.0);
   w_.assign(n, 0.0);
-  const int m = link_count();
-  // Greedy colouring in link order (structural links first), then a stable sort by colour.
-  std::vector<std::uint64_t> used(static_cast<std::size_t>(n) * 4, 0);  // 256 colours max
-  std::vector<int> colour(m, 0);
-  for (int k = 0; k < m; ++k) {
-    const std::uint64_t* ua = &used[4 * static_cast<std::size_t>(topo_.a[k])];
-    const std::uint64_t* ub = &used[4 * static_cast<std::size_t>(topo_.b[k])];
-    int c = 0;
-    while (c < 255 && (((ua[c / 64] | ub[c / 64]) >> (c % 64)) & 1u) != 0) ++c;
-    colour[k] = c;
-    used[4 * static_cast<std::size_t>(topo_.a[k]) + c / 64] |= std::uint64_t{1} << (c % 64);
-    used[4 * static_cast<std::size_t>(topo_.b[k]) + c / 64] |= std::uint64_t{1} << (c % 64);
-    colours_ = std::max(colours_, c + 1);
-  }
-  std::vector<int> by_colour(m);
-  for (int k = 0; k < m; ++k) by_colour[k] = k;
-  std::stable_sort(by_colour.begin(), by_colour.end(), [&colour](int p, int q) { return colour[p] < colour[q]; });
-  order_ = by_colour;
-  const int slots = m;
-  links_.a.assign(slots, 0);
-  links_.b.assign(slots, 0);
-  links_.rest.assign(slots, 0.0);
-  links_.wa.assign(slots, 0.0);
-  links_.wb.assign(slots, 0.0);
+  target_rows_.resize(kMaxTargets);
+  kernel_.configure(topo_);
   const SolverParams& s = params_.solver;
   if (s.plasticity_rate > 0) {
-    for (int p = 0; p < slots; ++p)
-      if (!s.plastic_bending_only || topo_.kind[order_[p]] == LinkKind::bending)
-        plastic_links_.push_back(p);
+    for (int k = 0; k < link_count(); ++k)
+      if (!s.plastic_bending_only || topo_.kind[k] == LinkKind::bending) plastic_links_.push_back(k);
   }
   contacts_.configure(topo_, params_.grid, s);
 }
@@ -58,19 +35,16 @@ void XpbdSheet::set_positions(std::span<const Vec3> pos) noexcept {
 }
 
 void XpbdSheet::prepare_frame(double dt_s) noexcept {
+  if (prepared_version_ == links_version_ && prepared_dt_ == dt_s) return;
+  prepared_version_ = links_version_;
+  prepared_dt_ = dt_s;
   const double inv_dts2 = 1.0 / (dt_s * dt_s);
   for (int i = 0; i < node_count(); ++i) w_[i] = pinned_[i] ? 0.0 : 1.0 / mass_[i];
-  const int slots = static_cast<int>(order_.size());
-  for (int p = 0; p < slots; ++p) {
-    const int k = order_[p];
+  for (int k = 0; k < link_count(); ++k) {
     const double wa = w_[topo_.a[k]], wb = w_[topo_.b[k]];
     const double den = wa + wb + compliance_[k] * inv_dts2;
     const double inv = den > 0 ? 1.0 / den : 0.0;
-    links_.a[p] = topo_.a[k];
-    links_.b[p] = topo_.b[k];
-    links_.rest[p] = rest_[k] + plastic_[k];
-    links_.wa[p] = wa * inv;
-    links_.wb[p] = wb * inv;
+    kernel_.set_link(k, rest_[k] + plastic_[k], wa * inv, wb * inv);
   }
 }
 
@@ -103,37 +77,48 @@ void XpbdSheet::apply_keypoint_velocities(double dt_s) noexcept {
 }
 
 void XpbdSheet::project_links() noexcept {
-  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 must be three packed doubles");
-  project_links_rt(links_, &x_[0].x);
+  kernel_.project_rt(x_);
 }
 
 // seed 001 Eq. 4, generalised to a bilinear sheet point c = sum b_e x_e:
 // x_e -= w_e b_e (c - x_d) / (sum w_e b_e^2 + alpha_input / dt_s^2).
-void XpbdSheet::project_targets(double dt_s) noexcept {
+// The weights are fixed within a frame: computed once, applied every substep.
+void XpbdSheet::prepare_targets(double dt_s) noexcept {
   const double at = params_.solver.target_compliance_m_per_n / (dt_s * dt_s);
   for (int t = 0; t < n_targets_; ++t) {
     const SheetPointStencil& s = target_stencil_[t];
-    Vec3 c;
+    TargetRow& r = target_rows_[t];
     double den = at;
     for (int e = 0; e < 4; ++e) {
-      c += s.bilinear[e] * x_[s.node[e]];
-      den += w_[s.node[e]] * s.bilinear[e] * s.bilinear[e];
+      r.node[e] = s.node[e];
+      r.b[e] = s.bilinear[e];
+      r.wb[e] = w_[s.node[e]] * s.bilinear[e];
+      den += r.wb[e] * s.bilinear[e];
     }
-    if (!(den > 0)) continue;
-    const Vec3 err = (1.0 / den) * (c - targets_[t].world_mm);
-    for (int e = 0; e < 4; ++e) x_[s.node[e]] -= (w_[s.node[e]] * s.bilinear[e]) * err;
+    r.inv_den = den > 0 ? 1.0 / den : 0.0;
+    r.world = targets_[t].world_mm;
+  }
+}
+
+void XpbdSheet::project_targets() noexcept {
+  Vec3* x = x_.data();
+  for (int t = 0; t < n_targets_; ++t) {
+    const TargetRow r = target_rows_[t];  // a copy: the stores to x cannot alias it
+    if (!(r.inv_den > 0)) continue;
+    const Vec3 c = r.b[0] * x[r.node[0]] + r.b[1] * x[r.node[1]] + r.b[2] * x[r.node[2]] + r.b[3] * x[r.node[3]];
+    const Vec3 err = r.inv_den * (c - r.world);
+    for (int e = 0; e < 4; ++e) x[r.node[e]] -= r.wb[e] * err;
   }
 }
 
 void XpbdSheet::update_plasticity() noexcept {
   const double a = params_.solver.plasticity_rate;
   const double eps_y = params_.solver.yield_strain;
-  for (const std::int32_t p : plastic_links_) {
-    const int k = order_[p];
+  for (const std::int32_t k : plastic_links_) {
     const double l = rest_[k];
     const double dl = norm(x_[topo_.b[k]] - x_[topo_.a[k]]) - l;
     plastic_[k] = plastic_update(dl, plastic_[k], a, eps_y * l);
-    links_.rest[p] = l + plastic_[k];
+    kernel_.set_rest(k, l + plastic_[k]);
   }
 }
 
@@ -143,6 +128,7 @@ void XpbdSheet::step_rt(double dt) noexcept {
   const int ns = sp.substeps;
   const double dts = dt / ns;
   prepare_frame(dts);
+  prepare_targets(dts);
   const int n = node_count();
   // Collision candidates once per frame, with a margin covering this frame's motion.
   double vmax = 0;
@@ -164,8 +150,9 @@ void XpbdSheet::step_rt(double dt) noexcept {
       x_[i] += dts * v_[i];
     }
     project_links();
-    project_targets(dts);
-    contacts_.solve_rt(x_, prev_, w_);
+    project_targets();
+    const int every = std::max(1, sp.self_collision_every);
+    contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);
     const double inv = 1.0 / dts;
     for (int i = 0; i < n; ++i) {
       if (pinned_[i]) {

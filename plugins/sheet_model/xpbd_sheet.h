@@ -2,8 +2,11 @@
 // One frame of dt: N_s substeps of dt_s = dt / N_s, each:
 //   key-point velocities (seed 000 Eqs. 1-4) -> prediction (seed 001 Eq. 1) ->
 //   links, Gauss-Seidel, one pass, lambda = 0 per substep (seed 001 Eqs. 2-3) ->
-//   zero-length target springs (seed 001 Eq. 4) -> contacts (table, shapes, layers) ->
-//   velocities from positions -> plastic update (seed 001 III.C).
+//   zero-length target springs (seed 001 Eq. 4) -> contacts (table, shapes; layers every
+//   solver.self_collision_every substeps and on the last) -> velocities from positions ->
+//   plastic update (seed 001 III.C).
+// Link constants are rebuilt only when links_version() or dt_s change; target-spring
+// weights once per frame; contact candidates once per frame.
 // Storage is allocated in the constructor; step_rt allocates nothing.
 #pragma once
 
@@ -27,22 +30,31 @@ class XpbdSheet final : public SheetModel {
   [[nodiscard]] const char* backend_name() const noexcept override { return "xpbd"; }
 
   [[nodiscard]] const ContactStats& contact_stats() const noexcept { return contacts_.stats(); }
-  [[nodiscard]] int link_colours() const noexcept { return colours_; }
+  [[nodiscard]] const LinkKernel& link_kernel() const noexcept { return kernel_; }
+  LinkKernel& link_kernel() noexcept { return kernel_; }
 
  private:
   void prepare_frame(double dt_s) noexcept;
   void apply_keypoint_velocities(double dt_s) noexcept;
   void project_links() noexcept;
-  void project_targets(double dt_s) noexcept;
+  void prepare_targets(double dt_s) noexcept;
+  void project_targets() noexcept;
   void update_plasticity() noexcept;
 
   std::vector<Vec3> x_, v_, prev_, kvel_;
   std::vector<double> kweight_;
   std::vector<double> w_;  // inverse mass, 0 for pinned nodes, 1/kg
-  PackedLinks links_;                        // refreshed at the start of every frame
-  std::vector<std::int32_t> order_;          // storage slot -> link index
-  std::vector<std::int32_t> plastic_links_;  // storage slots of elasto-plastic links
-  int colours_ = 0;
+  struct TargetRow {        // one zero-length target spring, fixed within a frame
+    std::int32_t node[4];
+    double b[4], wb[4];     // bilinear weights; w_e * b_e
+    double inv_den;         // 1 / (sum w_e b_e^2 + alpha_input / dt_s^2), 0: inactive
+    Vec3 world;             // target, mm
+  };
+  std::vector<TargetRow> target_rows_;  // capacity kMaxTargets
+  LinkKernel kernel_;                        // link data, refreshed when links_version() or dt_s change
+  std::uint64_t prepared_version_ = ~std::uint64_t{0};
+  double prepared_dt_ = 0.0;
+  std::vector<std::int32_t> plastic_links_;  // elasto-plastic links
   ContactSolver contacts_;
 };
 

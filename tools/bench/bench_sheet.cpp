@@ -129,7 +129,8 @@ struct OdeEngine {
 };
 
 // Bullet 3.24 soft body with the same nodes, links and masses, in metres; ICL's settings:
-// linear stiffness 0.9 (0.001 across the crease), 10 position iterations, one 1/60 s step,
+// linear stiffness 0.9 (0.001 across the crease), as many position iterations as our
+// substeps (10: one link pass each), one 1/60 s step,
 // key-point coupling by node velocities lambda (k - c) (seed 000 Eq. 3) once per frame.
 struct BulletSheet {
   btSoftBodyRigidBodyCollisionConfiguration cfg;
@@ -143,6 +144,9 @@ struct BulletSheet {
   btSoftBody* sb = nullptr;
   XpbdSheet ref;  // topology, masses, stencils, crease test
   std::vector<TargetPoint> targets;
+  std::vector<SheetPointStencil> stencils;
+  std::vector<Vec3> vel;
+  std::vector<double> w;
   double lambda = 10.0;
 
   explicit BulletSheet(const SheetParams& p) : ref(p) {
@@ -174,7 +178,9 @@ struct BulletSheet {
       const bool cut = segments_cross(g.sheet_of(a), g.sheet_of(b), crease.a, crease.b);
       sb->appendLink(a, b, cut ? soft : stiff);
     }
-    sb->m_cfg.piterations = 10;
+    sb->m_cfg.piterations = p.solver.substeps;  // our link passes per frame
+    vel.resize(n);
+    w.resize(n);
     sb->m_cfg.kDF = 0.5;
     sb->getCollisionShape()->setMargin(0.0005);
     world.addSoftBody(sb);
@@ -185,13 +191,20 @@ struct BulletSheet {
     world.removeRigidBody(ground.get());
   }
   Engine engine() {
-    return {[this](std::span<const TargetPoint> t) { targets.assign(t.begin(), t.end()); },
+    // Like ours, the stencils are computed when the targets are set (outside the timed
+    // step), and the step allocates nothing.
+    return {[this](std::span<const TargetPoint> t) {
+              targets.assign(t.begin(), t.end());
+              stencils.resize(targets.size());
+              for (std::size_t k = 0; k < targets.size(); ++k) stencils[k] = ref.stencil(targets[k].sheet_mm);
+            },
             [this] {
               const int n = ref.node_count();
-              std::vector<Vec3> vel(n);
-              std::vector<double> w(n, 0.0);
-              for (const TargetPoint& t : targets) {
-                const SheetPointStencil s = ref.stencil(t.sheet_mm);
+              std::fill(vel.begin(), vel.end(), Vec3{});
+              std::fill(w.begin(), w.end(), 0.0);
+              for (std::size_t k = 0; k < targets.size(); ++k) {
+                const TargetPoint& t = targets[k];
+                const SheetPointStencil& s = stencils[k];
                 Vec3 c;
                 for (int e = 0; e < 4; ++e) {
                   const btVector3& q = sb->m_nodes[s.node[e]].m_x;
