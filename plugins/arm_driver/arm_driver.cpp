@@ -12,8 +12,7 @@
 
 #include "core/plugin.h"
 #include "core/port_types/arm.h"
-#include "drivers/can/mock_can_bus.h"
-#include "drivers/can/socket_can_bus.h"
+#include "drivers/host/link_params.h"
 #include "drivers/host/arm_host.h"
 
 namespace {
@@ -23,28 +22,10 @@ namespace dr = crease::drivers;
 class ArmDriver final : public Plugin {
  public:
   void configure(const Params& p, PortBinder& ports) override {
-    const std::string kind = p.get<std::string>("bus_kind", "mock");
-    const std::string bus = p.get<std::string>("bus");
     dr::ArmHostConfig cfg;
     cfg.node = static_cast<std::uint8_t>(p.get_in_range<int>("node", 10, 1, 126));
-    cfg.monitor.timeout_cycles = p.get_in_range<int>("timeout_cycles", 2, 1, 100);
-    cfg.monitor.crc_threshold = p.get_in_range<int>("crc_threshold", 10, 0, 1000);
-    if (kind == "mock") {
-      const auto host_node = static_cast<std::uint32_t>(p.get_in_range<int>("host_node", 100, 0, 100000));
-      try {
-        bus_ = std::make_unique<dr::MockCanBus>(dr::MockCanBusConfig{bus, host_node, 1'000'000, 5'000'000});
-      } catch (const std::exception& e) {
-        p.fail("bus", e.what());
-      }
-    } else if (kind == "socketcan") {
-      try {
-        bus_ = std::make_unique<dr::SocketCanBus>(dr::SocketCanConfig{bus, true, {}, false});
-      } catch (const std::exception& e) {
-        p.fail("bus", e.what());
-      }
-    } else {
-      p.fail("bus_kind", "must be 'mock' or 'socketcan', got '" + kind + "'");
-    }
+    cfg.monitor = dr::monitor_from_params(p);
+    bus_ = dr::open_bus_from_params(p);
     host_ = std::make_unique<dr::ArmHost>(*bus_, cfg);
     command_in_ = ports.latest_input<ArmCommand>("arm_command");
     state_out_ = ports.latest_output<ArmState>("arm_state", ArmState{});

@@ -23,8 +23,7 @@
 #include "core/plugin.h"
 #include "core/port_types/hand.h"
 #include "core/port_types/tactile.h"
-#include "drivers/can/mock_can_bus.h"
-#include "drivers/can/socket_can_bus.h"
+#include "drivers/host/link_params.h"
 #include "drivers/host/hand_host.h"
 #include "drivers/host/tactile_host.h"
 
@@ -44,29 +43,11 @@ DeviceHealth to_health(dr::LinkHealth h) {
 class HandDriver final : public Plugin {
  public:
   void configure(const Params& p, PortBinder& ports) override {
-    const std::string kind = p.get<std::string>("bus_kind", "mock");
-    const std::string bus = p.get<std::string>("bus");
     dr::HandHostConfig cfg;
     cfg.node = static_cast<std::uint8_t>(p.get_in_range<int>("node", 1, 1, 126));
     cfg.pressure_sensors = p.get<bool>("pressure_sensors", false);
-    cfg.monitor.timeout_cycles = p.get_in_range<int>("timeout_cycles", 2, 1, 100);
-    cfg.monitor.crc_threshold = p.get_in_range<int>("crc_threshold", 10, 0, 1000);
-    if (kind == "mock") {
-      const auto host_node = static_cast<std::uint32_t>(p.get_in_range<int>("host_node", 100, 0, 100000));
-      try {
-        bus_ = std::make_unique<dr::MockCanBus>(dr::MockCanBusConfig{bus, host_node, 1'000'000, 5'000'000});
-      } catch (const std::exception& e) {
-        p.fail("bus", e.what());
-      }
-    } else if (kind == "socketcan") {
-      try {
-        bus_ = std::make_unique<dr::SocketCanBus>(dr::SocketCanConfig{bus, true, {}, false});
-      } catch (const std::exception& e) {
-        p.fail("bus", e.what());
-      }
-    } else {
-      p.fail("bus_kind", "must be 'mock' or 'socketcan', got '" + kind + "'");
-    }
+    cfg.monitor = dr::monitor_from_params(p);
+    bus_ = dr::open_bus_from_params(p);
     host_ = std::make_unique<dr::HandHost>(*bus_, cfg);
     if (p.has("tactile_device")) {
       const std::string dev = p.get<std::string>("tactile_device");
