@@ -75,16 +75,6 @@ Dist percentiles_of(const std::vector<std::uint64_t>& hist) {
   return Dist{pct(50), pct(99), pct(99.9), max_us, total};
 }
 
-crease::InstanceSpec instance(const std::string& name, const std::string& lib, const std::string& loop,
-                              const std::string& yaml) {
-  crease::InstanceSpec s;
-  s.name = name;
-  s.library = lib;
-  s.loop = loop;
-  s.params = crease::Params(YAML::Load(yaml), "bench", name);
-  s.ports = {{"out", name + "_out"}};
-  return s;
-}
 
 // Adds the samples of `s` into `into` (same bucket layout).
 void accumulate(crease::rt::HistogramSnapshot& into, const crease::rt::HistogramSnapshot& s) {
@@ -107,11 +97,14 @@ int run(int argc, char** argv) {
   const auto mem = crease::rt::lock_memory(64u << 20);
   // cyclictest holds /dev/cpu_dma_latency at 0 by default; Crease's loop gets the same
   // (creased: daemon.cpu_dma_latency_us), released before cyclictest's turns.
-  auto dma = std::make_unique<crease::rt::DmaLatencyRequest>();
-  std::printf("jitter: %s: %s %s\n", mem.what.c_str(), mem.applied ? "applied" : "not applied:", mem.why.c_str());
+  std::unique_ptr<crease::rt::DmaLatencyRequest> dma;
+  auto print_step = [](const crease::rt::SetupStep& st) {
+    std::printf("jitter: %s: %s %s\n", st.what.c_str(), st.applied ? "applied" : "not applied:", st.why.c_str());
+  };
+  print_step(mem);
   crease::PluginHost background({CREASE_PLUGIN_DIR});
   background.add_loop({"vision", 15.0, 0, -1});
-  background.add_instance(instance("burn", "crease_test_slow", "vision",
+  background.add_instance(crease::bench::instance("burn", "crease_test_slow", "vision",
                                    "{busy_us: " + std::to_string(std::lround(background_ms * 1000)) + "}"));
   background.start();
   std::printf("jitter: background: a 15 Hz loop burning %.0f ms per cycle; %d turns of %.1f s each for Crease "
@@ -120,8 +113,6 @@ int run(int argc, char** argv) {
 
   crease::rt::HistogramSnapshot ours_hist;
   std::uint64_t overruns = 0, cycles = 0;
-  Dist ct_total;
-  std::vector<Dist> ct_chunks;
   std::string why;
   bool have_ct = true;
   std::vector<std::uint64_t> ct_hist;
@@ -129,18 +120,13 @@ int run(int argc, char** argv) {
     {
       dma = std::make_unique<crease::rt::DmaLatencyRequest>();
       const auto dma_step = dma->request(0);
-      if (c == 0) {
-        std::printf("jitter: %s: %s %s\n", dma_step.what.c_str(), dma_step.applied ? "applied" : "not applied:",
-                    dma_step.why.c_str());
-      }
+      if (c == 0) print_step(dma_step);
       crease::PluginHost host({CREASE_PLUGIN_DIR});
       host.add_loop({"control", 1000.0, priority, cpu});
-      host.add_instance(instance("noop", "crease_test_noop", "control", "{}"));
+      host.add_instance(crease::bench::instance("noop", "crease_test_noop", "control", "{}"));
       const auto steps = host.start();
       if (c == 0) {
-        for (const auto& st : steps) {
-          std::printf("jitter: %s: %s %s\n", st.what.c_str(), st.applied ? "applied" : "not applied:", st.why.c_str());
-        }
+        for (const auto& st : steps) print_step(st);
       }
       std::this_thread::sleep_for(std::chrono::duration<double>(chunk_s));
       const crease::Loop* control = host.loops()[0];

@@ -25,13 +25,7 @@ int run(int argc, char** argv) {
   crease::PluginHost host({CREASE_PLUGIN_DIR});
   crease::Loop& loop = host.add_loop({"bench", 1000.0, 0, -1});
   for (int i = 0; i < 10; ++i) {
-    crease::InstanceSpec s;
-    s.name = "noop" + std::to_string(i);
-    s.library = "crease_test_noop";
-    s.loop = "bench";
-    s.order = i;
-    s.ports = {{"out", "out" + std::to_string(i)}};
-    host.add_instance(s);
+    host.add_instance(crease::bench::instance("noop" + std::to_string(i), "crease_test_noop", "bench", "{}", i));
   }
   // The loop thread is not started: cycles run here, back to back, so only CPU cost is measured.
   crease::rt::CycleClock clock{0, 0, 0, 1'000'000};
