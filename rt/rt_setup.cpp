@@ -30,7 +30,7 @@ __attribute__((noinline)) void prefault_stack(std::size_t bytes) {
 std::vector<SetupStep> apply_thread_settings(const std::string& name, const ThreadSettings& s) {
   std::vector<SetupStep> steps;
   if (s.priority > 0) {
-    SetupStep step{"SCHED_FIFO priority " + std::to_string(s.priority) + " for loop '" + name + "'", false, {}};
+    SetupStep step{"SCHED_FIFO priority " + std::to_string(s.priority) + " for loop '" + name + "'", false, {}, SetupStep::Kind::sched_fifo};
     sched_param sp{};
     sp.sched_priority = s.priority;
     const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
@@ -44,7 +44,7 @@ std::vector<SetupStep> apply_thread_settings(const std::string& name, const Thre
     steps.push_back(std::move(step));
   }
   if (s.cpu >= 0) {
-    SetupStep step{"CPU affinity " + std::to_string(s.cpu) + " for loop '" + name + "'", false, {}};
+    SetupStep step{"CPU affinity " + std::to_string(s.cpu) + " for loop '" + name + "'", false, {}, SetupStep::Kind::affinity};
     cpu_set_t set;
     CPU_ZERO(&set);
     if (s.cpu >= CPU_SETSIZE) {
@@ -62,13 +62,14 @@ std::vector<SetupStep> apply_thread_settings(const std::string& name, const Thre
   }
   if (s.stack_prefault_bytes > 0) {
     prefault_stack(s.stack_prefault_bytes);
-    steps.push_back({"stack prefault " + std::to_string(s.stack_prefault_bytes / 1024) + " KiB for loop '" + name + "'", true, {}});
+    steps.push_back({"stack prefault " + std::to_string(s.stack_prefault_bytes / 1024) + " KiB for loop '" + name + "'", true, {},
+                     SetupStep::Kind::stack_prefault});
   }
   return steps;
 }
 
 SetupStep lock_memory(std::size_t prefault_heap_bytes) {
-  SetupStep step{"mlockall with " + std::to_string(prefault_heap_bytes >> 20) + " MiB heap prefault", false, {}};
+  SetupStep step{"mlockall with " + std::to_string(prefault_heap_bytes >> 20) + " MiB heap prefault", false, {}, SetupStep::Kind::memory_lock};
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
     const int err = errno;
     step.why = errno_text(err) +
@@ -95,7 +96,7 @@ DmaLatencyRequest::~DmaLatencyRequest() {
 }
 
 SetupStep DmaLatencyRequest::request(int microseconds) {
-  SetupStep step{"/dev/cpu_dma_latency " + std::to_string(microseconds) + " us", false, {}};
+  SetupStep step{"/dev/cpu_dma_latency " + std::to_string(microseconds) + " us", false, {}, SetupStep::Kind::dma_latency};
   const int fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
   if (fd < 0) {
     step.why = errno_text(errno) + ": CPU idle states are left to the kernel";

@@ -12,9 +12,11 @@
 namespace crease::rt {
 
 struct SetupStep {
+  enum class Kind { sched_fifo, affinity, stack_prefault, memory_lock, dma_latency };
   std::string what;    // e.g. "SCHED_FIFO priority 80 for loop 'control'"
   bool applied = false;
   std::string why;     // when not applied: the reason (errno text and a hint)
+  Kind kind = Kind::sched_fifo;
 };
 
 struct ThreadSettings {

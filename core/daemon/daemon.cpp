@@ -26,6 +26,12 @@ using control::RequestError;
 
 double us(std::uint64_t ns) { return double(ns) / 1000.0; }
 
+// One line per real-time setting: applied, or not and why.
+void log_step(const rt::SetupStep& step) {
+  if (step.applied) spdlog::info("{}: applied", step.what);
+  else spdlog::warn("{}: not applied: {}", step.what, step.why);
+}
+
 InstanceSpec to_spec(const config::PluginConfig& p, const std::string& file, std::size_t index) {
   InstanceSpec s;
   s.name = p.name;
@@ -73,14 +79,12 @@ int Daemon::run() {
   if (d.lock_memory) {
     const auto step = rt::lock_memory(static_cast<std::size_t>(d.prefault_heap_mb) << 20);
     facts_.mlockall_applied = step.applied;
-    if (step.applied) spdlog::info("{}: applied", step.what);
-    else spdlog::warn("{}: not applied: {}", step.what, step.why);
+    log_step(step);
   }
   rt::DmaLatencyRequest dma;
   if (d.cpu_dma_latency_us) {
     const auto step = dma.request(*d.cpu_dma_latency_us);
-    if (step.applied) spdlog::info("{}: applied", step.what);
-    else spdlog::warn("{}: not applied: {}", step.what, step.why);
+    log_step(step);
   }
 
   control::ServerOptions so;
@@ -95,14 +99,13 @@ int Daemon::run() {
   facts_.affinity_applied = true;
   bool any_fifo = false, any_cpu = false;
   for (const auto& step : host_->start()) {
-    const bool fifo = step.what.find("SCHED_FIFO") != std::string::npos;
-    const bool cpu = step.what.find("affinity") != std::string::npos;
+    const bool fifo = step.kind == rt::SetupStep::Kind::sched_fifo;
+    const bool cpu = step.kind == rt::SetupStep::Kind::affinity;
     any_fifo |= fifo;
     any_cpu |= cpu;
     if (fifo && !step.applied) facts_.sched_fifo_applied = false;
     if (cpu && !step.applied) facts_.affinity_applied = false;
-    if (step.applied) spdlog::info("{}: applied", step.what);
-    else spdlog::warn("{}: not applied: {}", step.what, step.why);
+    log_step(step);
   }
   observer_ = std::make_unique<StateObserver>(host_->ports(), options_.record_state, facts_.start_ns);
   facts_.sched_fifo_applied &= any_fifo;

@@ -79,12 +79,16 @@ TEST_CASE("settings that cannot be applied are reported, never fatal") {
   loop.stop();
   bool saw_cpu = false;
   for (const auto& st : steps) {
-    if (st.what.find("CPU affinity") != std::string::npos) {
+    if (st.kind == crease::rt::SetupStep::Kind::affinity) {
       saw_cpu = true;
+      CHECK(st.what.find("CPU affinity 100000 for loop 'prio'") != std::string::npos);
       CHECK_FALSE(st.applied);
       CHECK_FALSE(st.why.empty());
     }
-    if (st.what.find("SCHED_FIFO") != std::string::npos) CHECK(st.applied == loop.fifo_applied());
+    if (st.kind == crease::rt::SetupStep::Kind::sched_fifo) {
+      CHECK(st.what.find("SCHED_FIFO priority 50") != std::string::npos);
+      CHECK(st.applied == loop.fifo_applied());
+    }
   }
   CHECK(saw_cpu);
   CHECK(rec.runs.load() > 0);
