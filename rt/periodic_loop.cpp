@@ -47,7 +47,7 @@ void PeriodicLoop::run_thread() {
   timing_.started_ns.store(deadline, std::memory_order_relaxed);
   std::uint64_t cycle = 0;
   std::int64_t previous_wake = 0;
-  std::uint64_t executed = 0, overruns = 0, missed = 0;
+  std::uint64_t executed = 0, overruns = 0, missed = 0, late_wakes = 0;
 
   while (!stop_.load(std::memory_order_acquire)) {
     sleep_until_ns(deadline);
@@ -66,6 +66,7 @@ void PeriodicLoop::run_thread() {
     ++cycle;
     if (end >= deadline) {
       // Skip every deadline already past; never run a burst to catch up.
+      if (wake >= deadline) timing_.late_wakes.store(++late_wakes, std::memory_order_relaxed);
       const std::int64_t skipped = (end - deadline) / period + 1;
       deadline += skipped * period;
       cycle += static_cast<std::uint64_t>(skipped);

@@ -34,6 +34,9 @@ struct LoopTiming {
   std::atomic<std::uint64_t> cycles{0};          // bodies run
   std::atomic<std::uint64_t> overruns{0};        // bodies that ended after the next deadline
   std::atomic<std::uint64_t> missed_periods{0};  // deadlines skipped by the overrun policy
+  // Overruns whose wake-up itself came at or after the next deadline: the machine (or a
+  // higher-priority thread) held the loop, not its body.
+  std::atomic<std::uint64_t> late_wakes{0};
   std::atomic<std::int64_t> started_ns{0};       // first deadline
 };
 
