@@ -38,7 +38,8 @@ bool SimSource::grab(Frame& frame) {
   frame.timestamp_ns = mesh.timestamp_ns >= 0 ? mesh.timestamp_ns : start_ns_ + static_cast<std::int64_t>(next_) * period_ns_;
   frame.images.resize(renderer_->cameras().size());
   for (std::size_t k = 0; k < frame.images.size(); ++k) {
-    RenderedView v;  // fresh buffers: frame.images[k] keeps this one
+    RenderedView v;  // fresh buffers (frame.images[k] keeps this one), or the caller's
+    if (frame.fill_in_place) v.image = frame.images[k];
     renderer_->render(static_cast<int>(k), mesh, o, v);
     frame.images[k] = v.image;
   }
@@ -89,10 +90,20 @@ V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::strin
     throw std::invalid_argument("camera_v4l2: " + std::to_string(devices.size()) + " devices for " +
                                 std::to_string(cameras_.size()) + " calibrations");
   for (std::size_t k = 0; k < devices.size(); ++k) {
-    cv::VideoCapture cap(devices[k], cv::CAP_V4L2);
-    if (!cap.isOpened()) throw std::runtime_error(devices[k] + ": cannot open video device");
-    cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
-    cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
+    // Device nodes through V4L2; anything else (a video file, an image sequence pattern such as
+    // dir/%06d.png) through whichever backend opens it.
+    const bool device = devices[k].rfind("/dev/", 0) == 0;
+    cv::VideoCapture cap;
+    try {
+      cap.open(devices[k], device ? cv::CAP_V4L2 : cv::CAP_ANY);
+    } catch (const cv::Exception&) {
+      cap.release();  // unopenable: this camera delivers nothing, the others go on
+    }
+    if (cap.isOpened() && device) {
+      cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
+      cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
+    }
+    if (!cap.isOpened()) failed_.push_back(devices[k]);
     caps_.push_back(std::move(cap));
   }
 }
@@ -106,16 +117,16 @@ bool V4l2Source::grab(Frame& frame) {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
   frame.timestamp_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-  bool any = false;
   cv::Mat bgr;
   for (std::size_t k = 0; k < caps_.size(); ++k) {
     frame.images[k] = cv::Mat();
     if (!ok[k] || !caps_[k].retrieve(bgr) || bgr.empty()) continue;  // disconnected: others go on
     if (bgr.channels() == 3) cv::cvtColor(bgr, frame.images[k], cv::COLOR_BGR2GRAY);
-    else frame.images[k] = bgr.clone();
-    any = true;
+    else if (bgr.channels() == 1) frame.images[k] = bgr.clone();
+    const Camera& c = cameras_[k];
+    if (frame.images[k].cols != c.width || frame.images[k].rows != c.height) frame.images[k] = cv::Mat();
   }
-  return any;
+  return true;  // live cameras do not end; one that stopped delivers empty images
 }
 
 Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras) : dir_(dir), ncam_(cameras.size()) {

@@ -26,6 +26,9 @@ struct Frame {
   std::int64_t timestamp_ns = 0;
   std::uint64_t index = 0;
   std::vector<cv::Mat> images;  // one per camera, CV_8UC1; empty = nothing from that camera
+  // Set by the caller: images[k] are buffers of the right size to write into (a frame channel's
+  // set); a source that can fill them in place does (SimSource), instead of fresh buffers.
+  bool fill_in_place = false;
 };
 
 class CameraSource {
@@ -70,16 +73,23 @@ class ReplaySource final : public CameraSource {
   std::size_t next_ = 0;
 };
 
-// Live cameras through cv::VideoCapture (V4L2 backend); device k is cameras[k].
+// Live cameras through cv::VideoCapture; device k is cameras[k]. /dev/... opens with the V4L2
+// backend; any other string (a video file, an image sequence pattern) with whichever backend
+// OpenCV finds. A device that does not open, stops, or delivers another image size gives empty
+// images (the others go on); grab() never ends.
 class V4l2Source final : public CameraSource {
  public:
+  // Throws std::invalid_argument when devices and calibrations differ in number.
   V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices);
   [[nodiscard]] const std::vector<Camera>& cameras() const override { return cameras_; }
   bool grab(Frame& frame) override;
+  // The devices that did not open.
+  [[nodiscard]] const std::vector<std::string>& failed_devices() const { return failed_; }
 
  private:
   std::vector<Camera> cameras_;
   std::vector<cv::VideoCapture> caps_;
+  std::vector<std::string> failed_;
   std::uint64_t next_ = 0;
 };
 

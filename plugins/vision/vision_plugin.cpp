@@ -1,28 +1,29 @@
-// Plugin `vision`: camera source (sim / replay / v4l2) -> marker detection -> N-view
-// triangulation -> `keypoints` port. One plugin owns the sources as library objects: camera
-// images never cross a port (a fixed-capacity payload for five 1280x960 images would be 6 MB
-// copied per frame); only the key-points do. Capture and processing run on a worker thread
-// (VisionWorker); update() only hands frames over, so it neither allocates nor blocks.
+// Plugin `vision`: marker detection and N-view triangulation of the frame sets a camera source
+// plugin (camera_sim, camera_replay, camera_v4l2) publishes -> `keypoints` port.
+// The images come through the frame channel `channel` (core/frames), not through a port:
+// five 1280x960 images are 6 MB a set. The `frames` port (crease::CameraFrames) carries the
+// source's announcement. Detection and triangulation run on a worker thread woken by each
+// publish (VisionWorker); update() only copies the newest key-points out: no allocation, no
+// lock, no wait.
 //
 // Parameters (paths relative to the configuration file's folder):
-//   source: sim | replay | v4l2          cameras: DIR of cam0.yaml..   layout: layout.yaml
-//   replay_dir: DIR (replay)             devices: [/dev/video0, ...] (v4l2)
-//   record: DIR (optional, any source: writes the replay layout)
-//   sim: seed, noise, blur_px, occluders, fold_start_s, fold_duration_s, fold_angle_deg
-//   detector: decimate, full_search_interval;  max_reproj_px, refine
-// Outputs: keypoints (crease::Keypoints). Status: degraded when a camera delivered nothing,
-// no new frame came for `stale_cycles` cycles, or a replay ended; fault if the worker failed.
+//   cameras: DIR of cam0.yaml.. (the calibrations of the channel's cameras, in order; for a
+//            replay, the recording's folder)        channel: NAME (default "cameras")
+//   layout: layout.yaml     decimate, full_search_interval; max_reproj_px, refine; stale_cycles
+// Inputs: frames (crease::CameraFrames). Outputs: keypoints (crease::Keypoints).
+// Status: degraded when a camera delivered nothing, no new key-points came for
+// `stale_cycles` cycles, or the source ended; fault if the worker failed.
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <string>
 
+#include "camera_worker.h"
+#include "core/frames/frame_registry.h"
 #include "core/plugin.h"
+#include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
-#include "core/port_types/sheet_state.h"
-#include "rt/latest.h"
-#include "rt/clock.h"
-#include "marker_sheet.h"
 #include "vision_worker.h"
 
 namespace {
@@ -33,9 +34,12 @@ class VisionPlugin final : public crease::Plugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     const std::filesystem::path base = std::filesystem::path(p.file()).parent_path();
-    auto path = [&](const std::string& v) { return std::filesystem::path(v).is_absolute() ? v : (base / v).string(); };
-    const std::string source = p.get<std::string>("source", "sim");
-    const MarkerLayout layout = load_layout(path(p.get<std::string>("layout", "markers/layout.yaml")));
+    auto path = [&](const std::string& v) {
+      return std::filesystem::path(v).is_absolute() ? v : (base / v).string();
+    };
+    const MarkerLayout layout =
+        load_layout(path(p.get<std::string>("layout", "markers/layout.yaml")));
+    auto cams = load_camera_dir(path(p.get<std::string>("cameras", "cameras")));
     DetectorConfig det;
     det.decimate = p.get_in_range<int>("decimate", 2, 1, 4);
     det.full_search_interval = p.get_in_range<int>("full_search_interval", 8, 1, 1000);
@@ -43,85 +47,42 @@ class VisionPlugin final : public crease::Plugin {
     tri.max_reproj_px = p.get_in_range<double>("max_reproj_px", 2.0, 0.1, 50.0);
     tri.refine = p.get<bool>("refine", true);
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
-
-    std::unique_ptr<CameraSource> src;
-    if (source == "sim") {
-      auto cams = load_camera_dir(path(p.get<std::string>("cameras", "cameras")));
-      const double ppm = 8.0;
-      auto renderer = std::make_shared<const ViewRenderer>(face_texture(layout, Face::kFront, ppm),
-                                                           face_texture(layout, Face::kBack, ppm), ppm, cams);
-      RenderOptions ro;
-      ro.seed = static_cast<std::uint64_t>(p.get_in_range<int>("seed", 1, 0, 1 << 30));
-      ro.noise_sigma = p.get_in_range<double>("noise", 2.0, 0.0, 50.0);
-      ro.blur_sigma_px = p.get_in_range<double>("blur_px", 0.6, 0.0, 5.0);
-      ro.occluders = p.get_in_range<int>("occluders", 0, 0, 10);
-      const std::string truth = p.get<std::string>("truth", "builtin");
-      // The sheet to render: `port` takes it from the `sheet_truth` port (the simulated world);
-      // `builtin` is an analytic half fold of its own (no other plugin needed).
-      const double t0 = p.get_in_range<double>("fold_start_s", 1.0, 0.0, 1e6);
-      const double dur = p.get_in_range<double>("fold_duration_s", 4.0, 0.01, 1e6);
-      const double angle = p.get_in_range<double>("fold_angle_deg", 170.0, 0.0, 180.0) * CV_PI / 180.0;
-      const double period_s = p.get_in_range<double>("frame_period_s", 1.0 / 30, 1e-3, 10.0);
-      const SheetMesh flat = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0}, 0.1);
-      const double h = layout.sheet_h_mm;
-      std::function<SheetMesh(std::uint64_t)> mesh_at = [=](std::uint64_t i) {
-        const double s = std::clamp((double(i) * period_s - t0) / dur, 0.0, 1.0);
-        return fold_sheet(flat, h / 2, angle * s);
-      };
-      if (truth == "port") {
-        truth_in_ = ports.latest_input<crease::SheetState>("sheet_truth");
-        truth_buf_ = std::make_unique<crease::SheetState>();
-        truth_ch_ = std::make_shared<crease::rt::LatestChannel>(sizeof(crease::SheetState));
-        mesh_at = [ch = truth_ch_, buf = std::make_shared<crease::SheetState>(),
-                   fallback = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0}, 0.0)](std::uint64_t) {
-          // Worker thread: the newest truth the RT side handed over (flat until there is one).
-          if (!ch->read(buf.get(), 0).has_data() || buf->nodes_u < 2 || buf->nodes_v < 2) return fallback;
-          SheetMesh m;
-          m.nx = buf->nodes_u;
-          m.ny = buf->nodes_v;
-          m.w_mm = buf->width_mm;
-          m.h_mm = buf->height_mm;
-          m.timestamp_ns = buf->timestamp_ns;
-          m.nodes.resize(static_cast<std::size_t>(m.nx) * m.ny);
-          for (std::size_t k = 0; k < m.nodes.size(); ++k) {
-            m.nodes[k] = {buf->position_mm[k][0], buf->position_mm[k][1], buf->position_mm[k][2]};
-          }
-          return m;
-        };
-      } else if (truth != "builtin") {
-        p.fail("truth", "expected builtin or port, got '" + truth + "'");
-      }
-      src = std::make_unique<SimSource>(renderer, mesh_at, ro, static_cast<std::int64_t>(period_s * 1e9),
-                                        crease::rt::now_ns());
-    } else if (source == "replay") {
-      src = std::make_unique<ReplaySource>(path(p.get<std::string>("replay_dir")));
-    } else if (source == "v4l2") {
-      auto cams = load_camera_dir(path(p.get<std::string>("cameras", "cameras")));
-      std::vector<std::string> devices;
-      const YAML::Node d = p.raw("devices");
-      if (!d || !d.IsSequence()) p.fail("devices", "expected a list of video devices");
-      for (const auto& n : d) devices.push_back(n.as<std::string>());
-      src = std::make_unique<V4l2Source>(std::move(cams), devices);
-    } else {
-      p.fail("source", "expected sim, replay or v4l2, got '" + source + "'");
-    }
-    const std::string record = p.has("record") ? path(p.get<std::string>("record")) : std::string();
+    const std::string name = p.get<std::string>("channel", "cameras");
+    if (name.empty() || name.size() >= crease::CameraFrames::kChannelNameCapacity)
+      p.fail("channel", "expected a name of 1.." +
+                            std::to_string(crease::CameraFrames::kChannelNameCapacity - 1) +
+                            " characters");
+    std::memcpy(channel_name_, name.c_str(), name.size() + 1);
+    // Opens (or creates) the channel with these calibrations' cameras: a source with other
+    // cameras fails to configure with a message naming the channel and the camera.
+    auto channel = crease::frames::FrameRegistry::instance().open(name, channel_specs(cams));
     buf_ = std::make_unique<crease::Keypoints>();
+    frames_in_ = ports.latest_input<crease::CameraFrames>("frames");
     out_ = ports.latest_output<crease::Keypoints>("keypoints", crease::Keypoints{});
-    worker_ = std::make_unique<VisionWorker>(std::move(src), layout, det, tri, record);
+    worker_ = std::make_unique<VisionWorker>(std::move(channel), std::move(cams), layout, det, tri);
   }
 
   crease::Status update(const crease::Cycle& cycle) override {
-    if (truth_in_.bound() && truth_in_.read(*truth_buf_).is_new()) truth_ch_->write(truth_buf_.get(), cycle.time_ns);
-    switch (worker_->take_and_request_rt(*buf_)) {
+    bool source_degraded = false;
+    if (frames_in_.read(announce_).has_data()) {
+      if (std::strncmp(announce_.channel, channel_name_, sizeof channel_name_) != 0) {
+        if (!warned_channel_)
+          log_rt(crease::rt::LogLevel::warn, "the frames port announces another frame channel");
+        warned_channel_ = true;
+        source_degraded = true;
+      }
+      source_degraded = source_degraded || announce_.ended != 0;
+    }
+    switch (worker_->take_rt(*buf_)) {
       case VisionWorker::Take::fresh:
         out_.write(*buf_, cycle.time_ns);
         since_fresh_ = 0;
-        return buf_->cameras_ok == worker_->all_cameras_mask() ? crease::Status::ok : crease::Status::degraded;
+        return buf_->cameras_ok == worker_->all_cameras_mask() && !source_degraded
+                   ? crease::Status::ok
+                   : crease::Status::degraded;
       case VisionWorker::Take::none:
-        return ++since_fresh_ > stale_cycles_ ? crease::Status::degraded : crease::Status::ok;
-      case VisionWorker::Take::ended:
-        return crease::Status::degraded;
+        return ++since_fresh_ > stale_cycles_ || source_degraded ? crease::Status::degraded
+                                                                 : crease::Status::ok;
       case VisionWorker::Take::failed:
         log_rt(crease::rt::LogLevel::error, "vision worker failed (see host log)");
         return crease::Status::fault;
@@ -129,16 +90,22 @@ class VisionPlugin final : public crease::Plugin {
     return crease::Status::fault;
   }
 
+  // Non-RT, after a fault too: says why the worker stopped, if it did.
+  void deactivate() override {
+    if (worker_ && !worker_->error().empty())
+      std::fprintf(stderr, "%s: vision worker failed: %s\n", instance_name().c_str(),
+                   worker_->error().c_str());
+  }
   void cleanup() override { worker_.reset(); }
 
  private:
   std::unique_ptr<VisionWorker> worker_;
   std::unique_ptr<crease::Keypoints> buf_;
+  crease::LatestInput<crease::CameraFrames> frames_in_;
   crease::LatestOutput<crease::Keypoints> out_;
-  // truth: port — the sheet_truth input, and the hand-over to the worker's renderer.
-  crease::LatestInput<crease::SheetState> truth_in_;
-  std::unique_ptr<crease::SheetState> truth_buf_;
-  std::shared_ptr<crease::rt::LatestChannel> truth_ch_;
+  crease::CameraFrames announce_{};
+  char channel_name_[crease::CameraFrames::kChannelNameCapacity] = {};
+  bool warned_channel_ = false;
   int stale_cycles_ = 10;
   int since_fresh_ = 0;
 };

@@ -1,84 +1,84 @@
 #include "vision_worker.h"
 
-#include <cstring>
+#include <stdexcept>
+
+#include "camera_worker.h"
 
 namespace crease::vision {
 
-VisionWorker::VisionWorker(std::unique_ptr<CameraSource> source, const MarkerLayout& layout,
-                           const DetectorConfig& det, const TriangulationConfig& tri, const std::string& record_dir)
-    : source_(std::move(source)),
-      pipeline_(source_->cameras(), layout, det, tri),
-      result_(std::make_unique<crease::Keypoints>()) {
-  if (!record_dir.empty()) recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras());
-  const std::size_t n = std::min<std::size_t>(source_->cameras().size(), 32);
-  all_mask_ = n == 32 ? 0xffffffffu : (1u << n) - 1u;
+VisionWorker::VisionWorker(std::shared_ptr<crease::frames::FrameChannel> channel,
+                           std::vector<Camera> cameras, const MarkerLayout& layout,
+                           const DetectorConfig& det, const TriangulationConfig& tri)
+    : channel_(std::move(channel)),
+      pipeline_(cameras, layout, det, tri),
+      result_(std::make_unique<crease::Keypoints>()),
+      images_(cameras.size()) {
+  if (channel_->cameras() != channel_specs(cameras))
+    throw std::invalid_argument("frame channel '" + channel_->name() +
+                                "' does not have these cameras");
+  reader_ = channel_->try_claim_reader();
   thread_ = std::thread([this] { run(); });
 }
 
 VisionWorker::~VisionWorker() {
-  // Wait for a frame in flight, then stop the thread.
-  int s = state_.load(std::memory_order_acquire);
-  while (true) {
-    while (s == kRequested || s == kBusy) {
-      state_.wait(s, std::memory_order_acquire);
-      s = state_.load(std::memory_order_acquire);
-    }
-    if (state_.compare_exchange_weak(s, kStop, std::memory_order_acq_rel)) break;
-  }
-  state_.notify_all();
+  stop_.store(true, std::memory_order_release);
+  channel_->wake();
   thread_.join();
+  if (reader_) channel_->release_reader();
 }
 
 std::string VisionWorker::error() const {
-  return state_.load(std::memory_order_acquire) == kFailed ? error_ : std::string();
+  return failed_.load(std::memory_order_acquire) ? error_ : std::string();
 }
 
-VisionWorker::Take VisionWorker::take_and_request_rt(crease::Keypoints& out) noexcept {
-  Take t = Take::none;
-  int s = state_.load(std::memory_order_acquire);
-  if (s == kEnded) return Take::ended;
-  if (s == kFailed) return Take::failed;
-  if (s == kDone) {
-    // The worker does not touch result_ until we hand the slot back.
-    out.timestamp_ns = result_->timestamp_ns;
-    out.frame = result_->frame;
-    out.count = result_->count;
-    out.cameras_ok = result_->cameras_ok;
-    std::memcpy(out.points, result_->points, sizeof(crease::Keypoint) * result_->count);
-    t = Take::fresh;
-    state_.store(kIdle, std::memory_order_release);
-    s = kIdle;
+VisionWorker::Take VisionWorker::take_rt(crease::Keypoints& out) noexcept {
+  if (failed_.load(std::memory_order_acquire)) return Take::failed;
+  if (results_.sequence() == taken_) return Take::none;
+  const crease::rt::ReadInfo info = results_.read(&out, taken_);
+  if (!info.is_new()) return Take::none;
+  taken_ = info.seq;
+  return Take::fresh;
+}
+
+bool VisionWorker::claim_reader() {
+  while (!reader_) {
+    const std::uint64_t seen = channel_->signal();
+    if (stop_.load(std::memory_order_acquire)) return false;
+    reader_ = channel_->try_claim_reader();
+    if (!reader_) channel_->wait_signal(seen);  // the previous reader releases with a wake
   }
-  if (s == kIdle) {
-    state_.store(kRequested, std::memory_order_release);
-    state_.notify_one();
-  }
-  return t;
+  return true;
 }
 
 void VisionWorker::run() {
-  while (true) {
-    int s = state_.load(std::memory_order_acquire);
-    while (s != kRequested && s != kStop) {
-      state_.wait(s, std::memory_order_acquire);
-      s = state_.load(std::memory_order_acquire);
-    }
-    if (s == kStop) return;
-    state_.store(kBusy, std::memory_order_release);
-    int next = kDone;
-    try {
-      if (!source_->grab(frame_)) {
-        next = kEnded;
-      } else {
-        if (recorder_) recorder_->write(frame_);
-        pipeline_.process(frame_.images, frame_.timestamp_ns, *result_);
+  if (!claim_reader()) return;
+  try {
+    while (true) {
+      // Read the signal before looking: a publish after this changes it, so the wait returns.
+      const std::uint64_t seen = channel_->signal();
+      if (stop_.load(std::memory_order_acquire)) return;
+      const crease::frames::FrameSet* set = channel_->acquire_newest();
+      if (set == nullptr) {
+        channel_->wait_signal(seen);
+        continue;
       }
-    } catch (const std::exception& e) {
-      error_ = e.what();
-      next = kFailed;
+      for (std::size_t k = 0; k < images_.size(); ++k) {
+        const auto& spec = channel_->cameras()[k];
+        // A header over the channel's buffer: no copy. The pipeline only reads it.
+        images_[k] = set->valid(k) ? cv::Mat(spec.height, spec.width, CV_8UC1,
+                                             const_cast<std::uint8_t*>(set->pixels(k)))
+                                   : cv::Mat();
+      }
+      pipeline_.process(images_, set->stamp_ns, *result_);
+      results_.write(result_.get(), set->stamp_ns);
+      processed_.fetch_add(1, std::memory_order_release);
+      channel_->finish(set->sequence);  // a source in lockstep may grab the next frame
     }
-    state_.store(next, std::memory_order_release);
-    state_.notify_all();
+  } catch (const std::exception& e) {
+    error_ = e.what();
+    failed_.store(true, std::memory_order_release);
+    channel_->release_reader();  // a source in lockstep must not wait for a reader that stopped
+    reader_ = false;
   }
 }
 

@@ -1,8 +1,10 @@
-// Runs camera capture, detection and triangulation on a worker thread (non-RT: OpenCV
-// allocates), handing key-points to the vision loop's RT update without locks or allocation.
-// Protocol, one frame in flight: the RT side requests a frame (idle -> requested, futex wake),
-// the worker grabs + processes into its result buffer (busy), then marks it done; the RT side
-// copies the result out and returns the slot to idle. The RT side never waits.
+// Runs marker detection and triangulation on a worker thread (non-RT: OpenCV allocates) over
+// the frame sets a camera source publishes into a frame channel (core/frames), and hands the
+// key-points to the vision loop's RT update without locks or allocation.
+// The worker holds the channel's reader end. It wakes on every publish (no RT cycle between
+// capture and detection: no latency added by the split), processes the newest set in place
+// (the images are not copied), and writes the result to a latest channel; the RT side copies
+// out the newest result when there is a new one. The RT side never waits.
 #pragma once
 
 #include <atomic>
@@ -11,41 +13,52 @@
 #include <string>
 #include <thread>
 
-#include "camera_source.h"
+#include "core/frames/frame_channel.h"
 #include "core/port_types/keypoints.h"
 #include "keypoint_pipeline.h"
+#include "rt/latest.h"
 
 namespace crease::vision {
 
 class VisionWorker {
  public:
-  // Takes ownership of the source; `record_dir` non-empty writes every frame there.
-  VisionWorker(std::unique_ptr<CameraSource> source, const MarkerLayout& layout, const DetectorConfig& det,
-               const TriangulationConfig& tri, const std::string& record_dir);
+  // `cameras` are the calibrations of the channel's cameras, in its order (names and sizes must
+  // match: std::invalid_argument otherwise). The reader end is claimed now if free, else on the
+  // worker thread as soon as the previous reader releases it (a hot swap).
+  VisionWorker(std::shared_ptr<crease::frames::FrameChannel> channel, std::vector<Camera> cameras,
+               const MarkerLayout& layout, const DetectorConfig& det,
+               const TriangulationConfig& tri);
   ~VisionWorker();
   VisionWorker(const VisionWorker&) = delete;
   VisionWorker& operator=(const VisionWorker&) = delete;
 
-  enum class Take { none, fresh, ended, failed };
-  // RT-safe. If a processed frame is waiting, copies it into `out` (fresh). Then, if the worker
-  // is idle, requests the next frame. `ended`: the source has no more frames; `failed`: the
-  // worker stopped on an exception (see error()).
-  Take take_and_request_rt(crease::Keypoints& out) noexcept;
-  [[nodiscard]] std::uint32_t all_cameras_mask() const noexcept { return all_mask_; }
+  enum class Take { none, fresh, failed };
+  // RT-safe. Copies the newest result into `out` when there is one the caller has not taken
+  // (fresh); `failed`: the worker stopped on an exception (see error()).
+  Take take_rt(crease::Keypoints& out) noexcept;
+  [[nodiscard]] std::uint32_t all_cameras_mask() const noexcept {
+    return channel_->all_cameras_mask();
+  }
+  [[nodiscard]] std::uint64_t sets_processed() const noexcept {
+    return processed_.load(std::memory_order_acquire);
+  }
   [[nodiscard]] std::string error() const;  // non-RT, valid after `failed`
 
  private:
-  enum State : int { kIdle, kRequested, kBusy, kDone, kEnded, kFailed, kStop };
   void run();
+  bool claim_reader();  // worker thread; false when asked to stop first
 
-  std::unique_ptr<CameraSource> source_;
-  std::unique_ptr<Recorder> recorder_;
+  std::shared_ptr<crease::frames::FrameChannel> channel_;
   KeypointPipeline pipeline_;
-  std::unique_ptr<crease::Keypoints> result_;  // owned by whoever the state says
-  Frame frame_;
-  std::uint32_t all_mask_ = 0;
+  std::unique_ptr<crease::Keypoints> result_;  // worker thread
+  std::vector<cv::Mat> images_;                // worker thread: headers over the acquired set
+  crease::rt::LatestChannel results_{sizeof(crease::Keypoints)};
+  std::uint64_t taken_ = 0;  // RT side: results_ sequence last taken
   std::string error_;
-  std::atomic<int> state_{kIdle};
+  bool reader_ = false;  // worker thread: holds the channel's reader end
+  std::atomic<bool> failed_{false};
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> processed_{0};
   std::thread thread_;
 };
 

@@ -1,28 +1,51 @@
-// The `vision` plugin in a real loop: replaying a recording to the `keypoints` port, going
-// degraded when a camera stops delivering and when the recording ends.
-#include <chrono>
-#include <filesystem>
-#include <thread>
-
+// The camera source plugins (camera_replay, camera_sim, camera_v4l2) feeding the `vision`
+// plugin in a real loop: key-points on the `keypoints` port, frame sets through one frame
+// channel that both dlopen'd plugins (and this test) see; degraded, never stopped, when a
+// camera stops; a replay processed twice gives the same key-points; either end hot-swapped.
 #include <doctest/doctest.h>
 
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <thread>
+
 #include "camera_source.h"
+#include "core/frames/frame_registry.h"
 #include "core/plugin_host.h"
+#include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
 #include "marker_sheet.h"
+#include "rt/alloc_guard.h"
 
 using namespace std::chrono_literals;
 using namespace crease::vision;
+namespace fs = std::filesystem;
 
 namespace {
-std::string record_sequence(const std::string& name, int frames) {
-  const auto dir = std::filesystem::temp_directory_path() / ("crease_vision_plugin_" + std::to_string(::getpid())) / name;
-  std::filesystem::remove_all(dir);
-  const MarkerLayout layout = load_layout(std::string(CREASE_SOURCE_DIR) + "/config/markers/layout.yaml");
-  const auto cams = load_camera_dir(std::string(CREASE_SOURCE_DIR) + "/config/cameras");
-  auto r = std::make_shared<const ViewRenderer>(face_texture(layout, Face::kFront, 8), face_texture(layout, Face::kBack, 8), 8, cams);
+const std::string kSrc = CREASE_SOURCE_DIR;
+
+fs::path tmp(const std::string& name) {
+  const auto dir =
+      fs::temp_directory_path() / ("crease_vision_plugin_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+// Renders `frames` frames of the shipped rig (the sheet folding by 0.3 rad a frame) and
+// records them in the replay layout.
+std::string record_sequence(const std::string& name, int frames, double fold_per_frame = 0.0) {
+  const auto dir = tmp(name);
+  const MarkerLayout layout = load_layout(kSrc + "/config/markers/layout.yaml");
+  const auto cams = load_camera_dir(kSrc + "/config/cameras");
+  auto r = std::make_shared<const ViewRenderer>(face_texture(layout, Face::kFront, 8),
+                                                face_texture(layout, Face::kBack, 8), 8, cams);
   const SheetMesh flat = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0}, 0.1);
-  SimSource sim(r, [&](std::uint64_t) { return flat; }, RenderOptions{}, 33'000'000);
+  SimSource sim(
+      r,
+      [&](std::uint64_t i) {
+        return fold_sheet(flat, layout.sheet_h_mm / 2, fold_per_frame * double(i));
+      },
+      RenderOptions{.seed = 3, .occluders = 1}, 33'000'000);
   Recorder rec(dir.string(), cams);
   Frame f;
   for (int i = 0; i < frames; ++i) {
@@ -35,19 +58,21 @@ std::string record_sequence(const std::string& name, int frames) {
 struct Fixture {
   crease::PluginHost host{{CREASE_PLUGIN_DIR}};
   std::unique_ptr<crease::Keypoints> kp = std::make_unique<crease::Keypoints>();
-  Fixture() { host.add_loop({"vision", 30.0, 0, -1}); }
-  void add(const std::string& replay_dir) {
-    add_yaml("{source: replay, replay_dir: '" + replay_dir + "', layout: '" + std::string(CREASE_SOURCE_DIR) +
-             "/config/markers/layout.yaml'}");
-  }
+  explicit Fixture(double rate_hz = 30.0) { host.add_loop({"vision", rate_hz, 0, -1}); }
   // Relative paths resolve against config/ (the file named here).
-  void add_yaml(const std::string& yaml) {
+  void add(const std::string& name, const std::string& library, int order,
+           const std::string& yaml) {
     crease::InstanceSpec s;
-    s.name = "vision";
-    s.library = "vision";
+    s.name = name;
+    s.library = library;
     s.loop = "vision";
-    s.params = crease::Params(YAML::Load(yaml), std::string(CREASE_SOURCE_DIR) + "/config/test.yaml", "vision.params");
+    s.order = order;
+    s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
     host.add_instance(s);
+  }
+  void add_vision(const std::string& cameras_dir, const std::string& channel) {
+    add("vision", "vision", 10,
+        "{cameras: '" + cameras_dir + "', channel: " + channel + ", layout: markers/layout.yaml}");
   }
   const crease::Keypoints& read() {
     const auto* ch = host.ports().find_latest("keypoints");
@@ -55,50 +80,219 @@ struct Fixture {
     ch->read(kp.get(), 0);
     return *kp;
   }
-  std::uint64_t degraded() {
+  crease::CameraFrames frames() {
+    crease::CameraFrames f{};
+    const auto* ch = host.ports().find_latest("frames");
+    REQUIRE(ch != nullptr);
+    ch->read(&f, 0);
+    return f;
+  }
+  std::uint64_t degraded(const std::string& name) {
     for (const auto& i : host.instances())
-      if (i.name == "vision") return i.stats->degraded.load();
+      if (i.name == name) return i.stats->degraded.load();
     return 0;
+  }
+  crease::RunState state(const std::string& name) {
+    for (const auto& i : host.instances())
+      if (i.name == name) return i.state;
+    return crease::RunState::inactive;
   }
   template <class P>
   bool wait_for(P pred) {
-    for (int i = 0; i < 1000; ++i) {
+    for (int i = 0; i < 2000; ++i) {
       host.poll();
       if (pred()) return true;
-      std::this_thread::sleep_for(10ms);
+      std::this_thread::sleep_for(5ms);
     }
     return false;
   }
 };
+
+// Plays `dir` through camera_replay -> vision; key-points by vision frame.
+std::map<std::uint64_t, crease::Keypoints> replay_keypoints(const std::string& dir,
+                                                            const std::string& channel) {
+  Fixture fx(10.0);  // slow enough that the test sees every frame's key-points on the port
+  fx.add("cameras", "camera_replay", 5, "{replay_dir: '" + dir + "', channel: " + channel + "}");
+  fx.add_vision(dir, channel);
+  fx.host.start();
+  std::map<std::uint64_t, crease::Keypoints> out;
+  const auto ch = crease::frames::FrameRegistry::instance().find(channel);
+  REQUIRE(ch != nullptr);
+  REQUIRE(fx.wait_for([&] {
+    if (fx.read().count > 0) out.emplace(fx.kp->frame, *fx.kp);
+    // Done when the replay ended and the last set's key-points are on the port.
+    return fx.frames().ended != 0 && !out.empty() && out.rbegin()->first + 1 == ch->published();
+  }));
+  fx.host.stop();
+  return out;
+}
 }  // namespace
 
-TEST_CASE_FIXTURE(Fixture, "replay -> keypoints; a camera that stops makes it degraded, not stopped") {
+TEST_CASE(
+    "camera_replay -> vision: one channel for both plugins; a camera that stops makes both "
+    "degraded") {
   const std::string dir = record_sequence("gap", 4);
-  std::filesystem::remove(dir + "/cam2/000002.png");
-  std::filesystem::remove(dir + "/cam2/000003.png");
-  add(dir);
-  host.start();
-  REQUIRE(wait_for([&] { return read().frame >= 1 && read().count > 0; }));
-  CHECK(read().count == 35 * 5);
-  CHECK(read().cameras_ok == 0x1f);
-  REQUIRE(wait_for([&] { return read().frame >= 3; }));
-  CHECK(read().cameras_ok == 0x1b);  // camera 2 gone, the others still triangulate
-  CHECK(read().count == 35 * 5);
-  CHECK(degraded() > 0);
-  host.stop();
+  fs::remove(dir + "/cam2/000002.png");
+  fs::remove(dir + "/cam2/000003.png");
+  Fixture fx;
+  fx.add("cameras", "camera_replay", 5, "{replay_dir: '" + dir + "', channel: gap}");
+  fx.add_vision(dir, "gap");
+  // Both dlopen'd plugins opened the same channel, and this executable sees it too.
+  const auto ch = crease::frames::FrameRegistry::instance().find("gap");
+  REQUIRE(ch != nullptr);
+  CHECK(ch->writer_claimed());
+  CHECK(ch->reader_claimed());
+  fx.host.start();
+  REQUIRE(fx.wait_for([&] { return fx.read().frame >= 1 && fx.read().count > 0; }));
+  // From here on the loop thread (marked RT) runs both plugins' updates: nothing allocates.
+  REQUIRE(crease::rt::alloc_hooks_installed());  // the count below means something
+  const auto allocations = crease::rt::rt_allocation_count();
+  CHECK(fx.read().count == 35 * 5);
+  CHECK(fx.read().cameras_ok == 0x1f);
+  REQUIRE(fx.wait_for([&] { return fx.read().frame >= 3; }));
+  CHECK(fx.read().cameras_ok == 0x1b);  // camera 2 gone, the others still triangulate
+  CHECK(fx.read().count == 35 * 5);
+  REQUIRE(fx.wait_for([&] { return fx.frames().ended != 0; }));
+  CHECK(ch->published() == 4);
+  CHECK(ch->consumed() == 4);  // lockstep: the vision worker took every set
+  CHECK(std::string(fx.frames().channel) == "gap");
+  CHECK(fx.frames().cameras == 5);
+  CHECK(fx.degraded("cameras") > 0);
+  CHECK(fx.degraded("vision") > 0);
+  CHECK(fx.state("cameras") == crease::RunState::active);
+  CHECK(fx.state("vision") == crease::RunState::active);
+  CHECK(crease::rt::rt_allocation_count() == allocations);
+  fx.host.stop();
 }
 
-TEST_CASE_FIXTURE(Fixture, "sim source with the shipped cameras and layout, recording what it renders") {
-  const auto rec = std::filesystem::temp_directory_path() / ("crease_vision_plugin_" + std::to_string(::getpid())) / "simrec";
-  std::filesystem::remove_all(rec);
-  add_yaml("{source: sim, occluders: 1, fold_start_s: 0, fold_duration_s: 1, record: '" + rec.string() + "'}");
-  host.start();
-  REQUIRE(wait_for([&] { return read().frame >= 2; }));
-  CHECK(read().count > 100);
-  CHECK(read().timestamp_ns > 0);  // CLOCK_MONOTONIC capture time
-  host.stop();
-  CHECK(std::filesystem::exists(rec / "cam0.yaml"));
-  CHECK(std::filesystem::exists(rec / "cam4" / "000001.png"));
+TEST_CASE("camera_replay -> vision twice: identical key-points, frame by frame") {
+  const std::string dir = record_sequence("twice", 3, 0.3);
+  const auto a = replay_keypoints(dir, "twice.a");
+  const auto b = replay_keypoints(dir, "twice.b");
+  REQUIRE(a.size() >= 2);  // the poller saw most frames (every one at this rate)
+  CHECK(a.rbegin()->first == 2);
+  CHECK(b.rbegin()->first == 2);
+  int compared = 0;
+  for (const auto& [frame, ka] : a) {
+    const auto it = b.find(frame);
+    if (it == b.end()) continue;
+    const crease::Keypoints& kb = it->second;
+    CAPTURE(frame);
+    CHECK(ka.timestamp_ns == kb.timestamp_ns);
+    CHECK(ka.timestamp_ns == static_cast<std::int64_t>(frame) * 33'000'000);
+    REQUIRE(ka.count == kb.count);
+    CHECK(ka.count > 100);
+    CHECK(std::memcmp(ka.points, kb.points, sizeof(crease::Keypoint) * ka.count) == 0);
+    ++compared;
+  }
+  CHECK(compared >= 2);
+}
+
+TEST_CASE("camera_sim -> vision with the shipped cameras and layout, recording what it renders") {
+  const auto rec = tmp("simrec");
+  Fixture fx;
+  fx.add("cameras", "camera_sim", 5,
+         "{occluders: 1, fold_start_s: 0, fold_duration_s: 1, channel: sim, record: '" +
+             rec.string() + "'}");
+  fx.add_vision("cameras", "sim");
+  fx.host.start();
+  REQUIRE(fx.wait_for([&] { return fx.read().frame >= 2; }));
+  CHECK(fx.read().count > 100);
+  CHECK(fx.read().cameras_ok == 0x1f);
+  CHECK(fx.read().timestamp_ns > 0);  // CLOCK_MONOTONIC capture time
+  CHECK(fx.frames().sequence >= 3);
+  CHECK(fx.frames().valid_mask == 0x1f);
+  fx.host.stop();
+  CHECK(fs::exists(rec / "cam0.yaml"));
+  CHECK(fs::exists(rec / "cam4" / "000001.png"));
   ReplaySource replay(rec.string());
   CHECK(replay.frames() >= 2);
+}
+
+TEST_CASE("camera_v4l2 on image sequences and a missing /dev/video: the others go on, degraded") {
+  // Three of the shipped cameras; two "devices" are image sequences cv::VideoCapture opens, the
+  // third a video device that does not exist here.
+  const auto dir = tmp("v4l2");
+  fs::create_directories(dir / "cams");
+  for (int k = 0; k < 3; ++k)
+    fs::copy_file(kSrc + "/config/cameras/cam" + std::to_string(k) + ".yaml",
+                  dir / "cams" / ("cam" + std::to_string(k) + ".yaml"));
+  {
+    const MarkerLayout layout = load_layout(kSrc + "/config/markers/layout.yaml");
+    const auto cams = load_camera_dir((dir / "cams").string());
+    auto r = std::make_shared<const ViewRenderer>(face_texture(layout, Face::kFront, 8),
+                                                  face_texture(layout, Face::kBack, 8), 8, cams);
+    const SheetMesh flat = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0}, 0.1);
+    SimSource sim(
+        r, [&](std::uint64_t) { return flat; }, RenderOptions{}, 33'000'000);
+    Recorder rec((dir / "rec").string(), cams);  // camK/NNNNNN.png: an image sequence per camera
+    Frame f;
+    for (int i = 0; i < 3; ++i) {
+      REQUIRE(sim.grab(f));
+      rec.write(f);
+    }
+  }
+  const std::string devices = "['" + (dir / "rec" / "cam0" / "%06d.png").string() + "', '" +
+                              (dir / "rec" / "cam1" / "%06d.png").string() + "', /dev/video97]";
+  {
+    Fixture fx;
+    fx.add("cameras", "camera_v4l2", 5,
+           "{cameras: '" + (dir / "cams").string() + "', devices: " + devices + ", channel: v4l2}");
+    fx.add_vision((dir / "cams").string(), "v4l2");
+    fx.host.start();
+    REQUIRE(fx.wait_for([&] { return fx.read().count > 0; }));
+    const auto allocations = crease::rt::rt_allocation_count();
+    CHECK(fx.read().cameras_ok == 0x3u);
+    CHECK(fx.read().count == 35 * 5);  // two views triangulate every key-point
+    REQUIRE(fx.wait_for([&] { return fx.degraded("cameras") > 0 && fx.degraded("vision") > 0; }));
+    CHECK(fx.state("cameras") == crease::RunState::active);
+    CHECK(fx.state("vision") == crease::RunState::active);
+    CHECK(crease::rt::rt_allocation_count() == allocations);  // updates allocate nothing
+    fx.host.stop();
+  }  // unloads both plugins: their workers release the channel's ends
+
+  // No device at all: still configures and runs, degraded.
+  Fixture none;
+  none.add("cameras", "camera_v4l2", 5,
+           "{cameras: '" + (dir / "cams").string() +
+               "', devices: [/dev/video97, /dev/video98, /dev/video99], channel: v4l2}");
+  none.add_vision((dir / "cams").string(), "v4l2");
+  none.host.start();
+  REQUIRE(none.wait_for([&] {
+    return none.frames().sequence > 0 && none.degraded("cameras") > 0 &&
+           none.degraded("vision") > 0;
+  }));
+  CHECK(none.frames().valid_mask == 0u);
+  CHECK(none.state("cameras") == crease::RunState::active);
+  none.host.stop();
+}
+
+TEST_CASE("hot swaps of camera_sim and vision: the new instances take over the channel's ends") {
+  Fixture fx;
+  fx.add("cameras", "camera_sim", 5, "{channel: swap}");
+  fx.add_vision("cameras", "swap");
+  fx.host.start();
+  const auto ch = crease::frames::FrameRegistry::instance().find("swap");
+  REQUIRE(ch != nullptr);
+  const auto* kp_port = fx.host.ports().find_latest("keypoints");
+  REQUIRE(kp_port != nullptr);
+  // Key-points keep coming: the port's sequence grows by `n` with sets processed.
+  auto keeps_going = [&](std::uint64_t n) {
+    const std::uint64_t from = kp_port->sequence();
+    return fx.wait_for([&] { return kp_port->sequence() >= from + n && fx.read().count > 100; });
+  };
+  REQUIRE(keeps_going(2));
+
+  fx.host.swap("vision", "vision");  // the new worker waits for the old one's reader end
+  REQUIRE(keeps_going(3));
+  CHECK(ch->reader_claimed());
+  fx.host.swap("cameras", "camera_sim");  // and the new camera worker for the writer end
+  const std::uint64_t published = ch->published();
+  REQUIRE(keeps_going(3));
+  CHECK(ch->published() > published);
+  CHECK(ch->writer_claimed());
+  CHECK(fx.state("cameras") == crease::RunState::active);
+  CHECK(fx.state("vision") == crease::RunState::active);
+  CHECK(fx.host.fault_count() == 0);
+  fx.host.stop();
 }

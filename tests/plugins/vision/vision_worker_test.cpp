@@ -1,10 +1,14 @@
+// VisionWorker: woken by each set published into a frame channel, key-points handed to the RT
+// side without allocation; calibrations that do not match the channel are refused.
 #include "vision_worker.h"
-
-#include <chrono>
-#include <thread>
 
 #include <doctest/doctest.h>
 
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "camera_worker.h"
 #include "rt/alloc_guard.h"
 #include "vision_fixture.h"
 
@@ -17,49 +21,54 @@ std::vector<Camera> small_rig() {
   return {look_at_camera("a", 480, 360, 500, {0, -60, 450}, {0, 0, 0}),
           look_at_camera("b", 480, 360, 500, {250, 250, 350}, {0, 0, 0})};
 }
-
-// A source that delivers `frames` frames, camera 1 missing from frame 2 on.
-class FlakySource final : public CameraSource {
- public:
-  FlakySource(std::shared_ptr<const ViewRenderer> r, SheetMesh mesh, int frames)
-      : sim_(std::move(r), [mesh](std::uint64_t) { return mesh; }, RenderOptions{}, 1000), left_(frames) {}
-  const std::vector<Camera>& cameras() const override { return sim_.cameras(); }
-  bool grab(Frame& f) override {
-    if (left_-- <= 0) return false;
-    sim_.grab(f);
-    if (f.index >= 2) f.images[1] = cv::Mat();
-    return true;
-  }
-
- private:
-  SimSource sim_;
-  int left_;
-};
 }  // namespace
 
-TEST_CASE("worker hands frames to the RT side without allocating; end of source is reported") {
+TEST_CASE("each published set is detected once, without allocating on the RT side") {
   crease::vision::testing::Scene s;
-  auto r = std::make_shared<const ViewRenderer>(face_texture(s.layout, Face::kFront, 4),
-                                                face_texture(s.layout, Face::kBack, 4), 4, small_rig());
-  VisionWorker w(std::make_unique<FlakySource>(r, s.flat(), 4), s.layout, DetectorConfig{}, TriangulationConfig{}, "");
+  const ViewRenderer r(face_texture(s.layout, Face::kFront, 4),
+                       face_texture(s.layout, Face::kBack, 4), 4, small_rig());
+  std::vector<RenderedView> views(2);
+  for (int k = 0; k < 2; ++k)
+    r.render(k, s.flat(), RenderOptions{}, views[static_cast<std::size_t>(k)]);
+
+  auto ch = std::make_shared<crease::frames::FrameChannel>("vision_worker_test",
+                                                           channel_specs(small_rig()));
+  REQUIRE(ch->try_claim_writer());
+  VisionWorker w(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{});
   CHECK(w.all_cameras_mask() == 0x3u);
+  CHECK(ch->reader_claimed());
+
   auto kp = std::make_unique<crease::Keypoints>();
   std::vector<std::uint32_t> cams_ok;
-  VisionWorker::Take t = VisionWorker::Take::none;
+  std::vector<std::int64_t> stamps;
+  std::uint32_t first_count = 0;
   const auto before = crease::rt::rt_allocation_count();
-  for (int i = 0; i < 3000 && t != VisionWorker::Take::ended; ++i) {
-    {
-      crease::rt::ScopedRtMark mark;
-      t = w.take_and_request_rt(*kp);
+  for (std::uint64_t f = 0; f < 4; ++f) {
+    for (std::size_t k = 0; k < 2; ++k)
+      std::memcpy(ch->write_slot().pixels(k), views[k].image.data, ch->image_bytes(k));
+    ch->publish(1000 + static_cast<std::int64_t>(f), f,
+                f >= 2 ? 0x1u : 0x3u);  // camera b stops at frame 2
+    VisionWorker::Take t = VisionWorker::Take::none;
+    for (int i = 0; i < 5000 && t == VisionWorker::Take::none; ++i) {
+      {
+        crease::rt::ScopedRtMark mark;
+        t = w.take_rt(*kp);
+      }
+      if (t == VisionWorker::Take::none) std::this_thread::sleep_for(1ms);
     }
-    if (t == VisionWorker::Take::fresh) cams_ok.push_back(kp->cameras_ok);
-    std::this_thread::sleep_for(2ms);
+    REQUIRE(t == VisionWorker::Take::fresh);
+    cams_ok.push_back(kp->cameras_ok);
+    stamps.push_back(kp->timestamp_ns);
+    if (f == 0) first_count = kp->count;
+    crease::rt::ScopedRtMark mark;
+    CHECK(w.take_rt(*kp) == VisionWorker::Take::none);  // taken once
   }
   CHECK(crease::rt::rt_allocation_count() == before);
-  CHECK(t == VisionWorker::Take::ended);
-  REQUIRE(cams_ok.size() == 4);
-  CHECK(cams_ok[0] == 0x3u);
-  CHECK(cams_ok[3] == 0x1u);
+  CHECK(cams_ok == std::vector<std::uint32_t>{0x3u, 0x3u, 0x1u, 0x1u});
+  CHECK(stamps == std::vector<std::int64_t>{1000, 1001, 1002, 1003});
+  CHECK(first_count > 20);  // key-points seen by both cameras
+  CHECK(ch->consumed() == 4);
+  CHECK(w.sets_processed() == 4);
   if (crease::rt::alloc_hooks_installed()) {  // the counter would have seen an allocation
     crease::rt::ScopedRtMark mark;
     static char* volatile sink;  // keeps the allocation from being elided
@@ -67,4 +76,16 @@ TEST_CASE("worker hands frames to the RT side without allocating; end of source 
     CHECK(crease::rt::rt_allocation_count() > before);
     delete[] sink;
   }
+}
+
+TEST_CASE("calibrations that do not match the channel are refused; the reader end is released") {
+  crease::vision::testing::Scene s;
+  auto ch = std::make_shared<crease::frames::FrameChannel>("vision_worker_test.b",
+                                                           channel_specs(small_rig()));
+  auto other = small_rig();
+  other[1].width = 640;
+  CHECK_THROWS_WITH_AS(VisionWorker(ch, other, s.layout, DetectorConfig{}, TriangulationConfig{}),
+                       doctest::Contains("'vision_worker_test.b'"), std::invalid_argument);
+  { VisionWorker w(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}); }
+  CHECK_FALSE(ch->reader_claimed());
 }
