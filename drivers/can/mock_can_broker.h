@@ -1,14 +1,13 @@
 // MockCanBroker: the medium of a user-space CAN bus. Nodes (MockCanBus, in this process or
 // another) connect to it by bus name over AF_UNIX SOCK_SEQPACKET; the broker forwards every
 // frame to every other node, timestamps it with a bit-timed bus-load model (a virtual bus
-// clock at the configured bitrates) and injects seeded faults. Runs its own (non-RT) thread.
+// clock at the configured bitrates) and injects seeded faults. Frames travel through
+// shared-memory rings (mock_wire.h); one (non-RT) thread per process serves every broker of
+// that process (mock_reactor.h).
 #pragma once
 
-#include <atomic>
 #include <cstdint>
-#include <mutex>
 #include <string>
-#include <thread>
 
 #include "drivers/can/can_bus.h"
 
@@ -44,7 +43,7 @@ struct MockCanBrokerStats {
 
 class MockCanBroker {
  public:
-  // Binds the bus name and starts the broker thread. Throws std::runtime_error naming the bus
+  // Binds the bus name and joins the process's broker thread. Throws std::runtime_error naming the bus
   // if the name is taken or a socket call fails.
   explicit MockCanBroker(MockCanBrokerConfig cfg);
   ~MockCanBroker();
@@ -65,10 +64,8 @@ class MockCanBroker {
 
  private:
   struct Impl;
-  void run();
   MockCanBrokerConfig cfg_;
   Impl* impl_;
-  std::thread thread_;
 };
 
 // Runs a broker in the calling thread until SIGINT/SIGTERM (for `crease-simdevice broker`).

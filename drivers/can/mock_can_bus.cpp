@@ -1,10 +1,14 @@
 #include "drivers/can/mock_can_bus.h"
 
+#include <poll.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
+#include <new>
 #include <stdexcept>
 
 #include "drivers/can/mock_wire.h"
@@ -19,30 +23,99 @@ std::int64_t now_ns() noexcept {
 }  // namespace
 
 MockCanBus::MockCanBus(MockCanBusConfig cfg) : cfg_(std::move(cfg)) {
+  auto fail = [this](const char* what, int e) {
+    close_all();
+    throw std::runtime_error("mock CAN bus '" + cfg_.bus + "': " + what + " (" + std::strerror(e) + ")");
+  };
   sockaddr_un addr{};
   const socklen_t len = mockwire::make_address(cfg_.bus, addr);
   fd_ = ::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
-  if (fd_ < 0) throw std::runtime_error("mock CAN bus '" + cfg_.bus + "': socket: " + std::strerror(errno));
-  if (::connect(fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) {
-    const int e = errno;
-    ::close(fd_);
-    throw std::runtime_error("mock CAN bus '" + cfg_.bus + "': no broker (" + std::strerror(e) + ")");
+  if (fd_ < 0) fail("socket", errno);
+  if (::connect(fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) fail("no broker", errno);
+  // The shared segment: created here, handed to the broker with the hello.
+  const int shm_fd = ::memfd_create("crease-can-node", MFD_CLOEXEC);
+  if (shm_fd < 0) fail("memfd_create", errno);
+  void* p = MAP_FAILED;
+  if (::ftruncate(shm_fd, sizeof(mockwire::NodeShm)) == 0) {
+    p = ::mmap(nullptr, sizeof(mockwire::NodeShm), PROT_READ | PROT_WRITE, MAP_SHARED, shm_fd, 0);
   }
+  if (p == MAP_FAILED) {
+    const int e = errno;
+    ::close(shm_fd);
+    fail("shared memory", e);
+  }
+  shm_ = new (p) mockwire::NodeShm;
   mockwire::Record hello;
   hello.kind = mockwire::kHello;
   hello.frame.can_id = cfg_.node_id;
-  if (::send(fd_, &hello, sizeof(hello), MSG_NOSIGNAL) != sizeof(hello)) {
-    const int e = errno;
-    ::close(fd_);
-    throw std::runtime_error("mock CAN bus '" + cfg_.bus + "': hello: " + std::strerror(e));
+  iovec iov{&hello, sizeof(hello)};
+  alignas(cmsghdr) char ctl[CMSG_SPACE(2 * sizeof(int))] = {};
+  msghdr mh{};
+  mh.msg_iov = &iov;
+  mh.msg_iovlen = 1;
+  mh.msg_control = ctl;
+  mh.msg_controllen = CMSG_SPACE(sizeof(int));
+  cmsghdr* cm = CMSG_FIRSTHDR(&mh);
+  cm->cmsg_level = SOL_SOCKET;
+  cm->cmsg_type = SCM_RIGHTS;
+  cm->cmsg_len = CMSG_LEN(sizeof(int));
+  std::memcpy(CMSG_DATA(cm), &shm_fd, sizeof(int));
+  const ssize_t sent = ::sendmsg(fd_, &mh, MSG_NOSIGNAL);
+  const int send_errno = errno;
+  ::close(shm_fd);
+  if (sent != sizeof(hello)) fail("hello", send_errno);
+  // The welcome: the broker thread's eventfd and its page.
+  pollfd pfd{fd_, POLLIN, 0};
+  if (::poll(&pfd, 1, 5000) <= 0) fail("no welcome from the broker", ETIMEDOUT);
+  mockwire::Record welcome;
+  iov = {&welcome, sizeof(welcome)};
+  std::memset(ctl, 0, sizeof(ctl));
+  mh = {};
+  mh.msg_iov = &iov;
+  mh.msg_iovlen = 1;
+  mh.msg_control = ctl;
+  mh.msg_controllen = sizeof(ctl);
+  const ssize_t got = ::recvmsg(fd_, &mh, MSG_CMSG_CLOEXEC);
+  const int recv_errno = errno;
+  int fds[2] = {-1, -1};
+  cm = got > 0 ? CMSG_FIRSTHDR(&mh) : nullptr;
+  if (cm && cm->cmsg_level == SOL_SOCKET && cm->cmsg_type == SCM_RIGHTS && cm->cmsg_len == CMSG_LEN(2 * sizeof(int))) {
+    std::memcpy(fds, CMSG_DATA(cm), sizeof(fds));
   }
+  if (got != sizeof(welcome) || welcome.kind != mockwire::kWelcome || fds[0] < 0 || fds[1] < 0) {
+    for (int fd : fds) {
+      if (fd >= 0) ::close(fd);
+    }
+    fail("bad welcome from the broker", got < 0 ? recv_errno : EPROTO);
+  }
+  doorbell_fd_ = fds[0];
+  void* page = ::mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fds[1], 0);
+  const int map_errno = errno;
+  ::close(fds[1]);
+  if (page == MAP_FAILED) fail("broker page", map_errno);
+  reactor_ = static_cast<mockwire::ReactorShm*>(page);
 }
 
-MockCanBus::~MockCanBus() { ::close(fd_); }
+void MockCanBus::close_all() noexcept {
+  if (shm_) ::munmap(shm_, sizeof(mockwire::NodeShm));
+  if (reactor_) ::munmap(reactor_, 4096);
+  if (doorbell_fd_ >= 0) ::close(doorbell_fd_);
+  if (fd_ >= 0) ::close(fd_);
+  shm_ = nullptr;
+  reactor_ = nullptr;
+  doorbell_fd_ = fd_ = -1;
+}
 
-bool MockCanBus::tx_queue_full(std::int64_t now) const noexcept {
-  // The oldest queued frame must have left the (virtual) controller.
-  return cfg_.nominal_bps != 0 && tx_done_[static_cast<std::size_t>(tx_head_)] > now;
+MockCanBus::~MockCanBus() { close_all(); }
+
+void MockCanBus::wake_broker() noexcept {
+  // The ring index was stored seq_cst; the broker thread stores `sleeping` then reads the
+  // rings, both seq_cst: one of us sees the other.
+  if (reactor_->sleeping.load(std::memory_order_seq_cst) != 0 && reactor_->sleeping.exchange(0) != 0) {
+    const std::uint64_t one = 1;
+    (void)!::write(doorbell_fd_, &one, sizeof(one));
+    ++broker_wakeups_;
+  }
 }
 
 void MockCanBus::note_sent(const CanFrame& f, std::int64_t now) noexcept {
@@ -56,125 +129,100 @@ void MockCanBus::note_sent(const CanFrame& f, std::int64_t now) noexcept {
 }
 
 std::size_t MockCanBus::send_batch(std::span<const CanFrame> frames, SendResult* last) noexcept {
-  constexpr std::size_t kMax = 16;
   if (state_ == BusState::bus_off) {
     if (last) *last = SendResult::bus_off;
     return 0;
   }
-  std::size_t done = 0;
-  SendResult result = SendResult::ok;
-  while (done < frames.size() && result == SendResult::ok) {
-    const std::int64_t now = now_ns();
-    mockwire::Record recs[kMax];
-    iovec iov[kMax];
-    mmsghdr msgs[kMax];
-    // How many fit in the modelled tx queue (each frame occupies the slot it will free).
-    std::size_t n = 0;
-    std::int64_t free_at = tx_free_at_;
-    for (; n < kMax && done + n < frames.size(); ++n) {
-      if (cfg_.nominal_bps != 0) {
-        const std::size_t slot = static_cast<std::size_t>((tx_head_ + static_cast<int>(n)) % kTxQueueLen);
-        if (n >= static_cast<std::size_t>(kTxQueueLen) || tx_done_[slot] > now) break;
-        free_at = (free_at > now ? free_at : now) + can_frame_time_ns(frames[done + n], cfg_.nominal_bps, cfg_.data_bps);
-      }
-      recs[n].kind = mockwire::kData;
-      recs[n].node = cfg_.node_id;
-      recs[n].timestamp_ns = 0;
-      recs[n].frame = frames[done + n];
-      iov[n] = {&recs[n], sizeof(mockwire::Record)};
-      msgs[n] = {};
-      msgs[n].msg_hdr.msg_iov = &iov[n];
-      msgs[n].msg_hdr.msg_iovlen = 1;
-    }
-    if (n == 0) {
-      ++counters_.tx_no_buffers;
-      errno_ = ENOBUFS;
-      result = SendResult::no_buffers;
-      break;
-    }
-    const int sent = ::sendmmsg(fd_, msgs, static_cast<unsigned>(n), MSG_DONTWAIT | MSG_NOSIGNAL);
-    if (sent < 0) {
-      errno_ = errno;
-      result = (errno_ == EAGAIN || errno_ == EWOULDBLOCK || errno_ == ENOBUFS) ? SendResult::no_buffers : SendResult::error;
-      if (result == SendResult::no_buffers) ++counters_.tx_no_buffers;
-      break;
-    }
-    for (int k = 0; k < sent; ++k) note_sent(frames[done + static_cast<std::size_t>(k)], now);
-    done += static_cast<std::size_t>(sent);
-    if (static_cast<std::size_t>(sent) < n) {
-      ++counters_.tx_no_buffers;
-      errno_ = EAGAIN;
-      result = SendResult::no_buffers;
+  const std::int64_t now = now_ns();
+  // How many fit in the modelled tx queue (frame n takes the slot the oldest queued frame
+  // frees) and in the ring to the broker.
+  const std::size_t ring_free = shm_->tx.free_slots();
+  std::size_t n = 0;
+  for (; n < frames.size() && n < ring_free; ++n) {
+    if (cfg_.nominal_bps != 0) {
+      if (n >= static_cast<std::size_t>(kTxQueueLen)) break;
+      const std::size_t slot = static_cast<std::size_t>((tx_head_ + static_cast<int>(n)) % kTxQueueLen);
+      if (tx_done_[slot] > now) break;
     }
   }
+  // Publish in chunks with one index update each (only this node pushes; room checked).
+  for (std::size_t done = 0; done < n;) {
+    mockwire::Record recs[16];
+    const std::size_t m = std::min<std::size_t>(16, n - done);
+    for (std::size_t k = 0; k < m; ++k) {
+      recs[k].kind = mockwire::kData;
+      recs[k].node = cfg_.node_id;
+      recs[k].timestamp_ns = now;  // node -> broker: when it was sent
+      recs[k].frame = frames[done + k];
+      note_sent(frames[done + k], now);
+    }
+    shm_->tx.push_n(recs, static_cast<std::uint32_t>(m));
+    done += m;
+  }
+  if (n > 0) wake_broker();
+  SendResult result = SendResult::ok;
+  if (n < frames.size()) {
+    ++counters_.tx_no_buffers;
+    errno_ = ENOBUFS;
+    result = SendResult::no_buffers;
+  }
   if (last) *last = result;
-  return done;
+  return n;
 }
 
 SendResult MockCanBus::send(const CanFrame& f) noexcept {
-  if (state_ == BusState::bus_off) return SendResult::bus_off;
-  const std::int64_t now = now_ns();
-  if (tx_queue_full(now)) {
-    ++counters_.tx_no_buffers;
-    errno_ = ENOBUFS;
-    return SendResult::no_buffers;
-  }
-  mockwire::Record r;
-  r.kind = mockwire::kData;
-  r.node = cfg_.node_id;
-  r.frame = f;
-  const ssize_t n = ::send(fd_, &r, sizeof(r), MSG_DONTWAIT | MSG_NOSIGNAL);
-  if (n != sizeof(r)) {
-    errno_ = errno;
-    if (errno_ == EAGAIN || errno_ == EWOULDBLOCK || errno_ == ENOBUFS) {
-      ++counters_.tx_no_buffers;
-      return SendResult::no_buffers;
-    }
-    return SendResult::error;
-  }
-  note_sent(f, now);
-  return SendResult::ok;
+  SendResult r = SendResult::ok;
+  (void)send_batch({&f, 1}, &r);
+  return r;
 }
 
-RecvResult MockCanBus::try_receive(RxFrame& out) noexcept {
-  if (rx_pos_ == rx_count_) {
-    if (rx_partial_) {
-      // The last refill took everything that was queued: report empty once without a system
-      // call, so a cyclic reader costs one recvmmsg() per cycle. The next call asks again.
-      rx_partial_ = false;
-      return RecvResult::empty;
-    }
-    // Refill: one recvmmsg() takes up to kRxBatch records.
-    iovec iov[kRxBatch];
-    mmsghdr msgs[kRxBatch];
-    for (int k = 0; k < kRxBatch; ++k) {
-      iov[k] = {rx_records_[k], sizeof(mockwire::Record)};
+bool MockCanBus::rearm_rx() noexcept {
+  // Take every doorbell (1-byte records) off the socket, then clear the flag: a record the
+  // broker pushes after the clear rings a new doorbell; one pushed before is seen by the
+  // caller's second look at the ring.
+  char bytes[8];
+  iovec iov[8];
+  mmsghdr msgs[8];
+  for (;;) {
+    for (int k = 0; k < 8; ++k) {
+      iov[k] = {&bytes[k], 1};
       msgs[k] = {};
       msgs[k].msg_hdr.msg_iov = &iov[k];
       msgs[k].msg_hdr.msg_iovlen = 1;
     }
-    const int got = ::recvmmsg(fd_, msgs, kRxBatch, MSG_DONTWAIT, nullptr);
+    const int got = ::recvmmsg(fd_, msgs, 8, MSG_DONTWAIT, nullptr);
     if (got < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) break;
       errno_ = errno;
-      return (errno_ == EAGAIN || errno_ == EWOULDBLOCK || errno_ == EINTR) ? RecvResult::empty
-                                                                             : RecvResult::error;
+      return false;
     }
     for (int k = 0; k < got; ++k) {
-      if (msgs[k].msg_len != sizeof(mockwire::Record) || (msgs[k].msg_hdr.msg_flags & MSG_TRUNC)) {
-        errno_ = msgs[k].msg_len == 0 ? EPIPE : EPROTO;  // broker gone, or a record of the wrong size
-        return RecvResult::error;
+      if (msgs[k].msg_len == 0) {
+        errno_ = EPIPE;  // the broker is gone
+        return false;
       }
     }
-    if (got == 0) {
-      errno_ = EPIPE;
-      return RecvResult::error;
-    }
-    rx_pos_ = 0;
-    rx_count_ = got;
-    rx_partial_ = got < kRxBatch;
+    if (got < 8) break;
   }
+  shm_->rx_signalled.store(0, std::memory_order_seq_cst);  // then the caller reads the ring (seq_cst)
+  return true;
+}
+
+RecvResult MockCanBus::try_receive(RxFrame& out) noexcept {
   mockwire::Record r;
-  std::memcpy(&r, rx_records_[rx_pos_++], sizeof(r));
+  if (!shm_->rx.try_pop(r)) {
+    if (!rx_empty_once_) {
+      rx_empty_once_ = true;  // report empty once without a system call
+      return RecvResult::empty;
+    }
+    if (!rearm_rx()) return RecvResult::error;
+    if (!shm_->rx.try_pop(r)) return RecvResult::empty;
+  }
+  rx_empty_once_ = false;
+  if (shm_->rx_need_space.load(std::memory_order_seq_cst) != 0 && shm_->rx.size() <= mockwire::kRxRing / 2 &&
+      shm_->rx_need_space.exchange(0) != 0) {
+    wake_broker();  // the broker holds records for this ring, which is half empty now
+  }
   out.frame = r.frame;
   out.timestamp_ns = r.timestamp_ns;
   if (r.frame.is_error()) {
@@ -192,12 +240,13 @@ void MockCanBus::restart() noexcept {
   mockwire::Record r;
   r.kind = mockwire::kRestart;
   r.node = cfg_.node_id;
-  if (::send(fd_, &r, sizeof(r), MSG_DONTWAIT | MSG_NOSIGNAL) == sizeof(r)) {
+  if (shm_->tx.try_push(r)) {
+    wake_broker();
     state_ = BusState::error_active;
     tx_done_.fill(0);
     tx_free_at_ = 0;
   } else {
-    errno_ = errno;
+    errno_ = ENOBUFS;
   }
 }
 

@@ -1,10 +1,12 @@
 // MockCanBus: one node on a user-space CAN bus served by a MockCanBroker (same process or
-// another). Behaves like a raw CAN socket: record boundaries, non-blocking I/O, a pollable fd,
-// error frames that move the bus state, and a transmit queue of kTxQueueLen frames modelled at
-// the bus bitrate: a full queue gives SendResult::no_buffers, as ENOBUFS does on a real socket.
-// Receiving takes up to 16 records per recvmmsg(); once a partial batch is drained, one
-// try_receive reports empty without a system call (poll the fd or call again to see newer
-// frames), so a cyclic reader costs one system call per cycle.
+// another). Behaves like a raw CAN socket: non-blocking I/O, a pollable fd, error frames that
+// move the bus state, and a transmit queue of kTxQueueLen frames modelled at the bus bitrate:
+// a full queue gives SendResult::no_buffers, as ENOBUFS does on a real socket.
+// Frames travel through shared-memory rings (mock_wire.h): send and try_receive cost no system
+// call, except that a send wakes the broker thread when it sleeps (one eventfd write). fd()
+// polls readable when frames arrived; once try_receive has reported empty, a second empty call
+// in a row re-arms it (one system call), so a cyclic reader that stops at the first empty
+// costs none, and a poller sees at most one spurious wake-up.
 #pragma once
 
 #include <array>
@@ -13,6 +15,11 @@
 #include <string>
 
 #include "drivers/can/can_bus.h"
+
+namespace crease::drivers::mockwire {
+struct NodeShm;
+struct ReactorShm;
+}  // namespace crease::drivers::mockwire
 
 namespace crease::drivers {
 
@@ -34,7 +41,7 @@ class MockCanBus final : public CanBus {
   MockCanBus& operator=(const MockCanBus&) = delete;
 
   [[nodiscard]] SendResult send(const CanFrame& f) noexcept override;
-  // One sendmmsg() for the whole batch.
+  // One copy into the shared ring for the whole batch, at most one wake-up of the broker.
   std::size_t send_batch(std::span<const CanFrame> frames, SendResult* last) noexcept override;
   [[nodiscard]] RecvResult try_receive(RxFrame& out) noexcept override;
   [[nodiscard]] int fd() const noexcept override { return fd_; }
@@ -42,10 +49,15 @@ class MockCanBus final : public CanBus {
   void restart() noexcept override;
   [[nodiscard]] const CanBusCounters& counters() const noexcept override { return counters_; }
   [[nodiscard]] int errno_value() const noexcept override { return errno_; }
+  // How many sends (and restarts) found the broker thread asleep and woke it (a system call).
+  [[nodiscard]] std::uint64_t broker_wakeups() const noexcept { return broker_wakeups_; }
 
  private:
   MockCanBusConfig cfg_;
-  int fd_ = -1;
+  int fd_ = -1;           // connection to the broker: doorbells, hang-up
+  int doorbell_fd_ = -1;  // the broker thread's eventfd
+  mockwire::NodeShm* shm_ = nullptr;
+  mockwire::ReactorShm* reactor_ = nullptr;
   BusState state_ = BusState::error_active;
   CanBusCounters counters_;
   int errno_ = 0;
@@ -53,13 +65,12 @@ class MockCanBus final : public CanBus {
   std::array<std::int64_t, kTxQueueLen> tx_done_{};
   int tx_head_ = 0;
   std::int64_t tx_free_at_ = 0;
-  // Receive ring filled by one recvmmsg() when empty (records of mock_wire.h, 88 bytes each).
-  static constexpr int kRxBatch = 16;
-  alignas(8) std::uint8_t rx_records_[kRxBatch][88] = {};
-  int rx_pos_ = 0, rx_count_ = 0;
-  bool rx_partial_ = false;
-  [[nodiscard]] bool tx_queue_full(std::int64_t now) const noexcept;
+  std::uint64_t broker_wakeups_ = 0;
+  bool rx_empty_once_ = false;  // the last try_receive reported empty
   void note_sent(const CanFrame& f, std::int64_t now) noexcept;
+  void wake_broker() noexcept;
+  [[nodiscard]] bool rearm_rx() noexcept;  // drains doorbells; false if the broker is gone
+  void close_all() noexcept;
 };
 
 }  // namespace crease::drivers

@@ -112,6 +112,55 @@ SendResult SocketCanBus::send(const CanFrame& f) noexcept {
   return SendResult::error;
 }
 
+std::size_t SocketCanBus::send_batch(std::span<const CanFrame> frames, SendResult* last) noexcept {
+  constexpr std::size_t kMax = 16;
+  SendResult result = SendResult::ok;
+  std::size_t done = 0;
+  while (done < frames.size() && result == SendResult::ok) {
+    if (state_ == BusState::bus_off) {
+      result = SendResult::bus_off;
+      break;
+    }
+    iovec iov[kMax];
+    mmsghdr msgs[kMax];
+    std::size_t n = 0;
+    for (; n < kMax && done + n < frames.size(); ++n) {
+      const CanFrame& f = frames[done + n];
+      if (f.is_fd() && !fd_enabled_) break;
+      iov[n] = {const_cast<CanFrame*>(&f), f.mtu()};
+      msgs[n] = {};
+      msgs[n].msg_hdr.msg_iov = &iov[n];
+      msgs[n].msg_hdr.msg_iovlen = 1;
+    }
+    if (n == 0) {  // an FD frame on a classic socket
+      errno_ = EINVAL;
+      result = SendResult::error;
+      break;
+    }
+    const int sent = ::sendmmsg(fd_, msgs, static_cast<unsigned>(n), MSG_DONTWAIT);
+    if (sent < 0) {
+      errno_ = errno;
+      if (errno_ == ENOBUFS || errno_ == EAGAIN || errno_ == EWOULDBLOCK) {
+        ++counters_.tx_no_buffers;
+        result = SendResult::no_buffers;
+      } else {
+        if (errno_ == ENETDOWN) state_ = BusState::stopped;
+        result = SendResult::error;
+      }
+      break;
+    }
+    counters_.tx_frames += static_cast<std::uint64_t>(sent);
+    done += static_cast<std::size_t>(sent);
+    if (static_cast<std::size_t>(sent) < n) {  // the kernel stopped at a full queue
+      ++counters_.tx_no_buffers;
+      errno_ = ENOBUFS;
+      result = SendResult::no_buffers;
+    }
+  }
+  if (last) *last = result;
+  return done;
+}
+
 RecvResult SocketCanBus::try_receive(RxFrame& out) noexcept {
   iovec iov{&out.frame, sizeof(CanFrame)};
   alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];

@@ -38,6 +38,8 @@ class SocketCanBus final : public CanBus {
   static bool available(std::string* reason);
 
   [[nodiscard]] SendResult send(const CanFrame& f) noexcept override;
+  // One sendmmsg() for up to 16 frames at a time; stops at the first frame not accepted.
+  std::size_t send_batch(std::span<const CanFrame> frames, SendResult* last) noexcept override;
   [[nodiscard]] RecvResult try_receive(RxFrame& out) noexcept override;
   [[nodiscard]] int fd() const noexcept override { return fd_; }
   [[nodiscard]] BusState state() const noexcept override { return state_; }

@@ -73,7 +73,8 @@ void HandHost::write_from_rt(const hand::Command& desired, const hand::Stiffness
     safe_sent_ = true;  // nothing can be sent; the device's watchdog holds it safe
     return;
   }
-  // Everything this cycle sends goes out in one batch (one system call on the mock bus).
+  // Everything this cycle sends goes out in one batch (one sendmmsg on SocketCAN, one ring
+  // update on the mock bus).
   CanFrame out[5];
   std::size_t n = 0;
   if (!operational_ && cycle_ % static_cast<std::uint64_t>(cfg_.nmt_retry_cycles) == 1) {

@@ -7,9 +7,11 @@
 
 namespace crease::drivers {
 
-// RT-safe (table lookup).
+// RT-safe. Uses SSE4.2's crc32 instruction where the CPU has it, else a table.
 [[nodiscard]] std::uint32_t crc32c(std::span<const std::uint8_t> bytes) noexcept;
 // Continues a CRC: crc32c_update(crc32c(a), b) == crc32c(a ++ b).
 [[nodiscard]] std::uint32_t crc32c_update(std::uint32_t crc, std::span<const std::uint8_t> bytes) noexcept;
+// The table path alone (tests compare it with the instruction path).
+[[nodiscard]] std::uint32_t crc32c_update_portable(std::uint32_t crc, std::span<const std::uint8_t> bytes) noexcept;
 
 }  // namespace crease::drivers

@@ -3,62 +3,35 @@
 #include <doctest/doctest.h>
 #include <linux/can/error.h>
 #include <poll.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstring>
+#include <memory>
+#include <random>
 #include <set>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "drivers/can/mock_can_broker.h"
+#include "drivers/can/mock_reactor.h"
+#include "mock_bus_test_support.h"
 #include "rt/alloc_guard.h"
 
 using namespace crease::drivers;
+using namespace crease::drivers::testing;
 
 namespace {
-std::string unique_bus(const char* tag) {
-  static int n = 0;
-  return std::string(tag) + "-" + std::to_string(::getpid()) + "-" + std::to_string(++n);
-}
-
-// Waits up to timeout_ms for one data frame (error frames are returned too).
-RecvResult recv_wait(CanBus& bus, RxFrame& out, int timeout_ms = 1000) {
-  for (;;) {
-    const RecvResult r = bus.try_receive(out);
-    if (r != RecvResult::empty) return r;
-    pollfd p{bus.fd(), POLLIN, 0};
-    if (::poll(&p, 1, timeout_ms) <= 0) return RecvResult::empty;
-  }
-}
-
-std::vector<std::uint32_t> drain_ids(CanBus& bus, int quiet_ms = 50) {
-  std::vector<std::uint32_t> ids;
-  RxFrame rx;
-  while (recv_wait(bus, rx, quiet_ms) == RecvResult::frame) ids.push_back(rx.frame.id());
-  return ids;
-}
-
-CanFrame frame_with_id(std::uint32_t id) {
-  const std::uint8_t b[4] = {static_cast<std::uint8_t>(id), 0xA5, 0x5A, 0x01};
-  return CanFrame::fd(id, b);
-}
-
-MockCanBusConfig node(const std::string& bus, std::uint32_t id, std::uint32_t bps = 0) {
-  return {bus, id, bps, bps ? 5'000'000u : 0u};
-}
-
-void wait_nodes(const MockCanBroker& b, int n) {
-  for (int i = 0; i < 200 && b.connected_nodes() < n; ++i) ::usleep(2000);
-  REQUIRE(b.connected_nodes() == n);
-}
+void require_nodes(const MockCanBroker& b, int n) { REQUIRE(wait_nodes(b, n)); }
 }  // namespace
 
 TEST_CASE("frames travel between nodes in one process, not back to the sender") {
   const std::string name = unique_bus("inproc");
   MockCanBroker broker({name, 0, 0, false});
   MockCanBus a(node(name, 1)), b(node(name, 2)), c(node(name, 3));
-  wait_nodes(broker, 3);
+  require_nodes(broker, 3);
   std::uint8_t payload[64];
   for (int i = 0; i < 64; ++i) payload[i] = static_cast<std::uint8_t>(i * 3);
   const CanFrame f = CanFrame::fd(0x181, payload);
@@ -83,7 +56,7 @@ TEST_CASE("a full transmit queue gives no_buffers (ENOBUFS emulation) and drains
   const std::string name = unique_bus("enobufs");
   MockCanBroker broker({name, 125'000, 125'000, false});
   MockCanBus a(node(name, 1, 125'000)), b(node(name, 2, 125'000));
-  wait_nodes(broker, 2);
+  require_nodes(broker, 2);
   const std::uint8_t b8[8] = {};
   const CanFrame f = CanFrame::classic(0x100, b8);  // ~1 ms each at 125 kbit/s
   int ok = 0;
@@ -106,54 +79,13 @@ TEST_CASE("a full transmit queue gives no_buffers (ENOBUFS emulation) and drains
   CHECK(dt == can_frame_time_ns(f, 125'000, 125'000));
 }
 
-TEST_CASE("nodes in separate processes share a bus") {
-  const std::string name = unique_bus("xproc");
-  const pid_t child = ::fork();
-  REQUIRE(child >= 0);
-  if (child == 0) {
-    // Echo server: answers every frame with id + 1. Retries until the broker exists.
-    for (int attempt = 0; attempt < 500; ++attempt) {
-      try {
-        MockCanBus bus(node(name, 7));
-        RxFrame rx;
-        int echoed = 0;
-        while (echoed < 100 && recv_wait(bus, rx, 2000) == RecvResult::frame) {
-          CanFrame out = rx.frame;
-          out.can_id = rx.frame.id() + 1;
-          while (bus.send(out) != SendResult::ok) ::usleep(100);
-          ++echoed;
-        }
-        ::_exit(echoed == 100 ? 0 : 3);
-      } catch (...) {
-        ::usleep(2000);
-      }
-    }
-    ::_exit(2);
-  }
-  MockCanBroker broker({name, 0, 0, false});
-  MockCanBus a(node(name, 1));
-  wait_nodes(broker, 2);
-  int good = 0;
-  for (std::uint32_t i = 0; i < 100; ++i) {
-    REQUIRE(a.send(frame_with_id(0x200 + 2 * i)) == SendResult::ok);
-    RxFrame rx;
-    REQUIRE(recv_wait(a, rx) == RecvResult::frame);
-    if (rx.frame.id() == 0x201 + 2 * i && rx.frame.data[1] == 0xA5) ++good;
-  }
-  CHECK(good == 100);
-  int status = 0;
-  ::waitpid(child, &status, 0);
-  CHECK(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 0);
-}
-
 TEST_CASE("seeded faults: drop, duplicate, reorder, corrupt are reproducible") {
   auto run = [](const CanFaultConfig& faults) {
     const std::string name = unique_bus("faults");
     MockCanBroker broker({name, 0, 0, false});
     broker.set_faults(faults);
     MockCanBus a(node(name, 1)), b(node(name, 2));
-    wait_nodes(broker, 2);
+    require_nodes(broker, 2);
     for (std::uint32_t i = 0; i < 200; ++i) {
       while (a.send(frame_with_id(i)) != SendResult::ok) ::usleep(50);
       if (i % 16 == 0) ::usleep(200);
@@ -203,7 +135,7 @@ TEST_CASE("delay fault delivers late; error frames reach every node") {
   f.delay_ns = 20'000'000;
   broker.set_faults(f);
   MockCanBus a(node(name, 1)), b(node(name, 2));
-  wait_nodes(broker, 2);
+  require_nodes(broker, 2);
   REQUIRE(a.send(frame_with_id(5)) == SendResult::ok);
   RxFrame rx;
   CHECK(recv_wait(b, rx, 5) == RecvResult::empty);
@@ -221,7 +153,7 @@ TEST_CASE("bus-off holds until restart; a silent node's frames vanish") {
   const std::string name = unique_bus("busoff");
   MockCanBroker broker({name, 0, 0, false});
   MockCanBus a(node(name, 1)), b(node(name, 2));
-  wait_nodes(broker, 2);
+  require_nodes(broker, 2);
   broker.force_bus_off(1);
   RxFrame rx;
   REQUIRE(recv_wait(a, rx) == RecvResult::error_frame);
@@ -249,7 +181,7 @@ TEST_CASE("send and try_receive do not allocate") {
   const std::string name = unique_bus("alloc");
   MockCanBroker broker({name, 0, 0, false});
   MockCanBus a(node(name, 1)), b(node(name, 2));
-  wait_nodes(broker, 2);
+  require_nodes(broker, 2);
   REQUIRE(crease::rt::alloc_hooks_installed());
   {
     crease::rt::ScopedRtMark mark;
@@ -275,7 +207,7 @@ TEST_CASE("back-pressure: a fast reader gets every frame in order; a node that n
   const std::string name = unique_bus("bp");
   MockCanBroker broker({name, 0, 0, false});
   MockCanBus a(node(name, 1)), b(node(name, 2)), idle(node(name, 3));
-  wait_nodes(broker, 3);
+  require_nodes(broker, 3);
   constexpr std::uint32_t kFrames = 30'000;
   std::uint32_t sent = 0, got = 0, out_of_order = 0;
   RxFrame rx;
@@ -296,4 +228,124 @@ TEST_CASE("back-pressure: a fast reader gets every frame in order; a node that n
   CHECK(out_of_order == 0);
   CHECK(broker.stats().rx_overflow > 0);  // only the idle node lost frames
   CHECK(a.counters().tx_no_buffers > 0);  // the sender felt the back-pressure
+}
+
+TEST_CASE("the fd polls readable while frames wait and goes quiet once drained") {
+  const std::string name = unique_bus("fd");
+  MockCanBroker broker({name, 0, 0, false});
+  MockCanBus a(node(name, 1)), b(node(name, 2));
+  require_nodes(broker, 2);
+  for (int round = 0; round < 3; ++round) {
+    REQUIRE(a.send(frame_with_id(static_cast<std::uint32_t>(round))) == SendResult::ok);
+    pollfd p{b.fd(), POLLIN, 0};
+    REQUIRE(::poll(&p, 1, 1000) == 1);
+    RxFrame rx;
+    REQUIRE(b.try_receive(rx) == RecvResult::frame);
+    CHECK(rx.frame.id() == static_cast<std::uint32_t>(round));
+    CHECK(b.try_receive(rx) == RecvResult::empty);  // first empty: no system call
+    CHECK(b.try_receive(rx) == RecvResult::empty);  // second: re-arms the fd
+    CHECK(::poll(&p, 1, 0) == 0);
+  }
+}
+
+TEST_CASE("no lost wake-ups: ping-pong with pauses that let the broker thread sleep or spin") {
+  const std::string name = unique_bus("pingpong");
+  MockCanBroker broker({name, 0, 0, false});
+  MockCanBus a(node(name, 1)), b(node(name, 2));
+  require_nodes(broker, 2);
+  constexpr int kRounds = 1500;
+  std::atomic<int> echoed{0};
+  std::thread echo([&] {
+    RxFrame rx;
+    while (echoed.load() < kRounds) {
+      if (recv_wait(b, rx, 2000) != RecvResult::frame) return;
+      CanFrame out = rx.frame;
+      out.can_id = rx.frame.id() ^ 0x400;
+      while (b.send(out) != SendResult::ok) ::usleep(10);
+      echoed.fetch_add(1);
+    }
+  });
+  std::mt19937 rng(3);
+  int answered = 0;
+  const std::uint64_t wakeups_before = a.broker_wakeups();
+  for (int i = 0; i < kRounds; ++i) {
+    // 0..300 us: sometimes inside the broker's polling window, sometimes after it slept.
+    ::usleep(static_cast<useconds_t>(rng() % 300));
+    const std::uint32_t id = static_cast<std::uint32_t>(i % 0x400);
+    REQUIRE(a.send(frame_with_id(id)) == SendResult::ok);
+    RxFrame rx;
+    REQUIRE(recv_wait(a, rx, 2000) == RecvResult::frame);
+    answered += rx.frame.id() == (id ^ 0x400) ? 1 : 0;
+  }
+  echo.join();
+  CHECK(answered == kRounds);
+  CHECK(echoed.load() == kRounds);
+  CHECK(a.broker_wakeups() > wakeups_before);  // some sends found the broker asleep
+}
+
+TEST_CASE("a send after an idle pause wakes the broker thread; sends right after do not") {
+  const std::string name = unique_bus("wake");
+  MockCanBroker broker({name, 0, 0, false});
+  MockCanBus a(node(name, 1)), b(node(name, 2));
+  require_nodes(broker, 2);
+  ::usleep(20'000);  // the broker's polling window is long over
+  const std::uint64_t before = a.broker_wakeups();
+  const CanFrame burst[3] = {frame_with_id(1), frame_with_id(2), frame_with_id(3)};
+  SendResult last;
+  REQUIRE(a.send_batch(burst, &last) == 3);
+  CHECK(a.broker_wakeups() == before + 1);  // one wake-up for the whole batch
+  CHECK(drain_ids(b) == std::vector<std::uint32_t>{1, 2, 3});
+}
+
+TEST_CASE("brokers of one process share a thread; closing one leaves the others working") {
+  const std::string n1 = unique_bus("shared"), n2 = unique_bus("shared"), n3 = unique_bus("shared");
+  MockCanBroker b1({n1, 0, 0, false}), b3({n3, 0, 0, false});
+  auto b2 = std::make_unique<MockCanBroker>(MockCanBrokerConfig{n2, 0, 0, false});
+  MockCanBus a1(node(n1, 1)), c1(node(n1, 2)), a3(node(n3, 1)), c3(node(n3, 2));
+  auto a2 = std::make_unique<MockCanBus>(node(n2, 1));
+  require_nodes(b1, 2);
+  require_nodes(*b2, 1);
+  require_nodes(b3, 2);
+  REQUIRE(a1.send(frame_with_id(0x11)) == SendResult::ok);
+  REQUIRE(a3.send(frame_with_id(0x33)) == SendResult::ok);
+  RxFrame rx;
+  REQUIRE(recv_wait(c1, rx) == RecvResult::frame);
+  CHECK(rx.frame.id() == 0x11);
+  REQUIRE(recv_wait(c3, rx) == RecvResult::frame);
+  CHECK(rx.frame.id() == 0x33);
+  CHECK(recv_wait(c1, rx, 20) == RecvResult::empty);  // buses do not leak into each other
+  b2.reset();  // its node sees the hang-up
+  CHECK(recv_wait(*a2, rx, 1000) == RecvResult::error);
+  CHECK(a2->errno_value() == EPIPE);
+  a2.reset();
+  REQUIRE(a1.send(frame_with_id(0x12)) == SendResult::ok);
+  REQUIRE(recv_wait(c1, rx) == RecvResult::frame);
+  CHECK(rx.frame.id() == 0x12);
+  REQUIRE(c3.send(frame_with_id(0x34)) == SendResult::ok);
+  REQUIRE(recv_wait(a3, rx) == RecvResult::frame);
+  CHECK(rx.frame.id() == 0x34);
+}
+
+TEST_CASE("burst predictor: locks on a steady period, rides out one late start, re-learns after two") {
+  using crease::drivers::mockwire::BurstPredictor;
+  auto near = [](std::int64_t a, std::int64_t b) { return a > b - 5'000 && a < b + 5'000; };
+  BurstPredictor p;
+  CHECK(p.next_ns() == -1);
+  CHECK(p.on_activity(1'000'000));
+  CHECK(p.on_activity(2'000'000));          // learns 1 ms
+  CHECK_FALSE(p.on_activity(2'050'000));    // the devices' answers: same burst
+  CHECK(p.on_activity(3'010'000));          // on schedule (within 5 %)
+  CHECK(p.next_ns() == -1);                 // not confirmed twice yet
+  CHECK(p.on_activity(4'000'000));
+  CHECK(near(p.next_ns(), 5'000'000));
+  CHECK(p.on_activity(5'200'000));          // a late loop: the schedule stays
+  CHECK(near(p.next_ns(), 6'000'000));
+  CHECK(p.on_activity(6'001'000));
+  CHECK(near(p.next_ns(), 7'000'000));
+  CHECK(p.on_activity(7'300'000));          // two starts off the schedule: re-learn
+  CHECK(p.on_activity(7'900'000));
+  CHECK(p.next_ns() == -1);
+  BurstPredictor slow;
+  for (std::int64_t t = 1; t <= 6; ++t) slow.on_activity(t * 50'000'000);  // 50 ms apart
+  CHECK(slow.next_ns() == -1);
 }

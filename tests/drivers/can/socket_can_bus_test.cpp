@@ -64,3 +64,22 @@ TEST_CASE("classic and FD frames round-trip on vcan0 with filters and timestamps
   CHECK(r.frame.len == 12);
   CHECK(rx.try_receive(r) == RecvResult::empty);
 }
+
+TEST_CASE("send_batch puts classic and FD frames on vcan0 in order with one sendmmsg") {
+  if (skip_without_vcan()) return;
+  SocketCanBus tx({"vcan0", true, {}, false});
+  SocketCanBus rx({"vcan0", true, {{0x130, 0x7F0}}, false});
+  const std::uint8_t b[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  const CanFrame frames[3] = {CanFrame::classic(0x131, b), CanFrame::fd(0x132, b), CanFrame::classic(0x133, b)};
+  SendResult last = SendResult::error;
+  REQUIRE(tx.send_batch(frames, &last) == 3);
+  CHECK(last == SendResult::ok);
+  CHECK(tx.counters().tx_frames == 3);
+  pollfd p{rx.fd(), POLLIN, 0};
+  for (const CanFrame& f : frames) {
+    RxFrame r;
+    REQUIRE(::poll(&p, 1, 1000) == 1);
+    REQUIRE(rx.try_receive(r) == RecvResult::frame);
+    CHECK(r.frame == f);
+  }
+}

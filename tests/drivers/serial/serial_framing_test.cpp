@@ -16,6 +16,19 @@ TEST_CASE("CRC-32C check value") {
   const Bytes s = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
   CHECK(crc32c(s) == 0xE3069283u);
   CHECK(crc32c_update(crc32c({s.data(), 4}), {s.data() + 4, 5}) == 0xE3069283u);
+  CHECK(crc32c_update_portable(0, s) == 0xE3069283u);
+}
+
+TEST_CASE("CRC-32C: the instruction path (where the CPU has one) equals the table path") {
+  std::mt19937 rng(7);
+  Bytes b(300);
+  for (auto& x : b) x = static_cast<std::uint8_t>(rng());
+  for (std::size_t len = 0; len <= b.size(); len += 1 + len / 8) {
+    for (std::size_t off = 0; off < 3; ++off) {
+      const std::span<const std::uint8_t> s{b.data() + off, len - (len >= off ? off : len)};
+      CHECK(crc32c_update(0x1234567u, s) == crc32c_update_portable(0x1234567u, s));
+    }
+  }
 }
 
 TEST_CASE("COBS known vectors and round trips") {
