@@ -32,6 +32,7 @@ int CollisionWorld::add_geom(dxGeom* g) {
     throw std::invalid_argument("sheet_model: collision shapes: more than 64");
   }
   geoms_.push_back(g);
+  ++version_;
   return static_cast<int>(geoms_.size()) - 1;
 }
 
@@ -64,6 +65,7 @@ void CollisionWorld::set_pose(int shape, Vec3 c, const double* rot) noexcept {
   if (shape < 0 || shape >= shape_count()) return;
   dxGeom* g = geoms_[shape];
   if (dGeomGetClass(g) == dPlaneClass) return;
+  ++version_;
   dGeomSetPosition(g, c.x, c.y, c.z);
   if (rot != nullptr) {
     dMatrix3 m = {rot[0], rot[1], rot[2], 0, rot[3], rot[4], rot[5], 0, rot[6], rot[7], rot[8], 0};

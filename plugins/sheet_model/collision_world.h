@@ -4,6 +4,7 @@
 // Configure-time: constructor and add_*; RT: set_pose, query_rt.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "vec3.h"
@@ -43,11 +44,14 @@ class CollisionWorld {
   int query_rt(Vec3 p, double radius_mm, ShapeContact* out, int capacity) const noexcept;
 
   [[nodiscard]] int shape_count() const noexcept { return static_cast<int>(geoms_.size()); }
+  // Incremented by every add_* and set_pose (contact caches compare it).
+  [[nodiscard]] std::uint64_t version() const noexcept { return version_; }
 
  private:
   int add_geom(dxGeom* g);
   std::vector<dxGeom*> geoms_;
   dxGeom* probe_ = nullptr;
+  std::uint64_t version_ = 0;
 };
 
 }  // namespace crease::sheet

@@ -18,7 +18,8 @@ constexpr double kBaryTolerance = 0.05;  // accept projections slightly outside 
 
 // Barycentric coordinates of p's projection onto the plane of (a, b, c), from the signed
 // areas: n = (b - a) x (c - a), nn = |n|^2 > 0. True when inside (with tolerance).
-bool barycentric(Vec3 p, Vec3 a, Vec3 b, Vec3 c, Vec3 n, double nn, double out[3]) {
+bool barycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double nn,
+                 double out[3]) {
   const double inv = 1.0 / nn;
   const Vec3 pa = a - p, pb = b - p, pc = c - p;
   out[0] = dot(cross(pb, pc), n) * inv;
@@ -94,7 +95,12 @@ void ContactSolver::configure(const Topology& topo, const GridParams& grid, cons
   self_enabled_ = solver.self_collision;
   const int n = topo.grid.count();
   shape_pairs_.resize(static_cast<std::size_t>(n) * kMaxContactsPerNode);
-  self_pairs_.resize(static_cast<std::size_t>(n) * 8);
+  self_pairs_.resize(static_cast<std::size_t>(n) * 16);
+  shape_active_.resize(shape_pairs_.size());
+  self_active_.resize(self_pairs_.size());
+  cand_tris_.assign(static_cast<std::size_t>(topo.triangle_count()), 0);
+  tri_stamp_.assign(static_cast<std::size_t>(topo.triangle_count()), 0);
+  tri_n_.assign(static_cast<std::size_t>(topo.triangle_count()), Vec3{});
   node_gi_.resize(n);
   node_gj_.resize(n);
   for (int i = 0; i < n; ++i) {
@@ -121,7 +127,8 @@ void ContactSolver::configure(const Topology& topo, const GridParams& grid, cons
   cell_mm_ = std::hypot(topo.grid.du, topo.grid.dv) + 2.0 * thickness_;
 }
 
-void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* world, double margin_mm) noexcept {
+void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* world, double margin_mm,
+                              double lateral_mm) noexcept {
   n_shape_ = 0;
   const int n = static_cast<int>(x.size());
   if (world != nullptr && world->shape_count() > 0) {
@@ -137,13 +144,62 @@ void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* wor
       }
     }
   }
-  stats_.shape_contacts = n_shape_;
   n_self_ = 0;
-  if (self_enabled_) detect_self_rt(x, margin_mm);
-  stats_.self_pairs = n_self_;
+  if (self_enabled_) detect_self_rt(x, margin_mm, std::max(0.0, lateral_mm));
+  std::copy_n(shape_pairs_.begin(), n_shape_, shape_active_.begin());
+  n_shape_active_ = n_shape_;
+  std::copy_n(self_pairs_.begin(), n_self_, self_active_.begin());
+  n_self_active_ = n_self_;
+  ++stamp_;
+  if (stamp_ == 0) {  // wrapped: no triangle may look current
+    std::fill(tri_stamp_.begin(), tri_stamp_.end(), 0u);
+    stamp_ = 1;
+  }
+  n_cand_tris_ = 0;
+  for (int k = 0; k < n_self_; ++k) {
+    const std::int32_t t = self_pairs_[k].tri;
+    if (tri_stamp_[t] == stamp_) continue;
+    tri_stamp_[t] = stamp_;
+    cand_tris_[n_cand_tris_++] = t;
+  }
+  stats_.shape_contacts = n_shape_active_;
+  stats_.self_pairs = n_self_active_;
+  stats_.self_candidates = n_self_;
 }
 
-void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) noexcept {
+void ContactSolver::select_rt(std::span<const Vec3> x, double margin_mm) noexcept {
+  const double rs = half_thickness_ + margin_mm;
+  n_shape_active_ = 0;
+  for (int k = 0; k < n_shape_; ++k) {
+    const ShapePair& c = shape_pairs_[k];
+    if (dot(c.normal, x[c.node]) - c.offset < rs) shape_active_[n_shape_active_++] = c;
+  }
+  const double reach = thickness_ + margin_mm;
+  const auto& tri = topo_->tri;
+  for (int k = 0; k < n_cand_tris_; ++k) {  // each candidate triangle's normal once
+    const std::int32_t t = cand_tris_[k];
+    const Vec3 a = x[tri[3 * t]];
+    tri_n_[t] = cross(x[tri[3 * t + 1]] - a, x[tri[3 * t + 2]] - a);
+  }
+  n_self_active_ = 0;
+  for (int k = 0; k < n_self_; ++k) {
+    const SelfPair& c = self_pairs_[k];
+    const Vec3& n = tri_n_[c.tri];  // references: see solve_rt
+    const double nn = dot(n, n);
+    if (!(nn > kMinArea2)) continue;
+    const Vec3& a = x[tri[3 * c.tri]];
+    const Vec3& xp = x[c.node];
+    const double dn = dot(xp - a, n);  // d |n|
+    if (dn * dn >= reach * reach * nn) continue;
+    double bary[3];
+    if (!barycentric(xp, a, x[tri[3 * c.tri + 1]], x[tri[3 * c.tri + 2]], n, nn, bary)) continue;
+    self_active_[n_self_active_++] = {c.node, c.tri, dn >= 0 ? 1.0 : -1.0};
+  }
+  stats_.shape_contacts = n_shape_active_;
+  stats_.self_pairs = n_self_active_;
+}
+
+void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm, double lateral_mm) noexcept {
   const int n = static_cast<int>(x.size());
   const double inv_cell = 1.0 / cell_mm_;
   auto cell_of = [inv_cell](double c) {  // floor without a libm call, clamped (NaN too) to +-1e9
@@ -180,7 +236,8 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
     int t, ti, tj;  // index; the grid column / row of its first corner
     Vec3 a, b, c, n, nrm;
     double nn;
-    double bl[3], bh[3];  // its box grown by reach and by the barycentric tolerance
+    double bl[3], bh[3];  // its box grown by reach, lateral and the barycentric tolerance
+    double tol[3];        // accepted barycentric coordinates >= -tol
   };
   constexpr int r = kSelfSkipCells + 1;
   const ScreenNodes nd{fx_.data(), fy_.data(), fz_.data(), gi_.data(), gj_.data()};
@@ -193,7 +250,7 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
     Screen sc{{0, 0, 0}, {0, 0, 0}, -(1 << 30), 1 << 30, -(1 << 30), 1 << 30};
     for (int t = t0; t < t1; ++t) {
       for (int v = 0; v < 3; ++v) {
-        const Vec3 p = x[tri[3 * t + v]];
+        const Vec3& p = x[tri[3 * t + v]];
         mn[0] = std::min(mn[0], p.x);
         mn[1] = std::min(mn[1], p.y);
         mn[2] = std::min(mn[2], p.z);
@@ -208,7 +265,7 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
       sc.nj1 = std::min(sc.nj1, node_gj_[first] + r);
     }
     for (int e = 0; e < 3; ++e) {
-      const double grow = reach + 2.0 * kBaryTolerance * (mx[e] - mn[e]) + 1e-9;
+      const double grow = reach + lateral_mm + 2.0 * kBaryTolerance * (mx[e] - mn[e]) + 1e-9;
       const double lo = mn[e] - grow, hi = mx[e] + grow;
       sc.lo[e] = static_cast<float>(lo - 1e-3 * (1.0 + std::fabs(lo)));
       sc.hi[e] = static_cast<float>(hi + 1e-3 * (1.0 + std::fabs(hi)));
@@ -235,7 +292,12 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
           q.n = cross(q.b - q.a, q.c - q.a);
           q.nn = dot(q.n, q.n);
           if (!(q.nn > kMinArea2)) continue;  // degenerate: no projection
-          q.nrm = (1.0 / std::sqrt(q.nn)) * q.n;
+          const double inv_len = 1.0 / std::sqrt(q.nn);
+          q.nrm = inv_len * q.n;
+          // A projection dist outside the edge opposite corner e has bary[e] = -dist |edge| / |n|.
+          q.tol[0] = kBaryTolerance + lateral_mm * norm(q.c - q.b) * inv_len;
+          q.tol[1] = kBaryTolerance + lateral_mm * norm(q.a - q.c) * inv_len;
+          q.tol[2] = kBaryTolerance + lateral_mm * norm(q.b - q.a) * inv_len;
           const double tmn[3] = {std::min({q.a.x, q.b.x, q.c.x}), std::min({q.a.y, q.b.y, q.c.y}),
                                  std::min({q.a.z, q.b.z, q.c.z})};
           const double tmx[3] = {std::max({q.a.x, q.b.x, q.c.x}), std::max({q.a.y, q.b.y, q.c.y}),
@@ -245,7 +307,7 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
             torn = torn || cell_of(tmx[e] + reach) - cell_of(tmn[e] - reach) > 3;
             // A projection accepted by barycentric() lies within 2 kBaryTolerance of the
             // extent outside the box: nodes outside bl..bh cannot pass both tests below.
-            const double grow = reach + 2.0 * kBaryTolerance * (tmx[e] - tmn[e]) + 1e-9;
+            const double grow = reach + lateral_mm + 2.0 * kBaryTolerance * (tmx[e] - tmn[e]) + 1e-9;
             q.bl[e] = tmn[e] - grow;
             q.bh[e] = tmx[e] + grow;
           }
@@ -256,7 +318,7 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
         const int p = base + std::countr_zero(mask);
         mask &= mask - 1;
         if (p >= n) break;
-        const Vec3 xp = x[p];
+        const Vec3& xp = x[p];  // a reference: see solve_rt
         for (int k = 0; k < ng; ++k) {
           const Tri& q = g[k];
           if (std::abs(node_gi_[p] - q.ti) <= r && std::abs(node_gj_[p] - q.tj) <= r)
@@ -267,7 +329,9 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm) no
           const double d = dot(xp - q.a, q.nrm);
           if (std::fabs(d) >= reach) continue;
           double bary[3];
-          if (!barycentric(xp, q.a, q.b, q.c, q.n, q.nn, bary)) continue;
+          if (!barycentric(xp, q.a, q.b, q.c, q.n, q.nn, bary) &&
+              !(bary[0] >= -q.tol[0] && bary[1] >= -q.tol[1] && bary[2] >= -q.tol[2]))
+            continue;
           if (n_self_ >= static_cast<int>(self_pairs_.size())) {
             ++stats_.dropped;
             continue;
@@ -283,8 +347,8 @@ void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std:
                              bool with_self) noexcept {
   // Nodes against rigid shapes: push out to half the thickness, then Coulomb friction on
   // the substep's tangential displacement.
-  for (int k = 0; k < n_shape_; ++k) {
-    const ShapePair& c = shape_pairs_[k];
+  for (int k = 0; k < n_shape_active_; ++k) {
+    const ShapePair& c = shape_active_[k];
     if (w[c.node] <= 0) continue;
     Vec3& p = x[c.node];
     const double pen = c.offset + half_thickness_ - dot(c.normal, p);
@@ -302,10 +366,12 @@ void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std:
   if (!with_self) return;
   // Nodes against triangles of other layers: keep the frame's side, thickness apart.
   const auto& tri = topo_->tri;
-  for (int k = 0; k < n_self_; ++k) {
-    const SelfPair& c = self_pairs_[k];
+  for (int k = 0; k < n_self_active_; ++k) {
+    const SelfPair& c = self_active_[k];
     const int ia = tri[3 * c.tri], ib = tri[3 * c.tri + 1], ic = tri[3 * c.tri + 2];
-    const Vec3 a = x[ia], b = x[ib], cc = x[ic];
+    // References, not copies: GCC copies a Vec3 through the stack with a 16 + 8 byte store
+    // and reads it back with loads that straddle both (a failed store forward, ~3 per pair).
+    const Vec3 &a = x[ia], &b = x[ib], &cc = x[ic];
     const Vec3 n = cross(b - a, cc - a);
     const double nn = dot(n, n);
     if (!(nn > kMinArea2)) continue;

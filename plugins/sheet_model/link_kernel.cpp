@@ -130,6 +130,65 @@ __attribute__((target("avx512f"))) void project_batch_avx512(const LinkKernel::B
   }
 }
 
+// Node positions (xyz doubles, node-major) of one grid row -> the padded float arrays of a
+// row-major layout (and the copies kept for the add-back), 8 nodes at a time. Slots past
+// the row's last node get 0 (they are padding). stride >= w and a multiple of 8.
+__attribute__((target("avx512f"))) void row_to_floats_avx512(const double* row, int w, float* const dst[6]) noexcept {
+  const __m512i ix1 = _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), ix2 = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13);
+  const __m512i iy1 = _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), iy2 = _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14);
+  const __m512i iz1 = _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), iz2 = _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15);
+  for (int i0 = 0; i0 < w; i0 += 8) {
+    const int nd = 3 * std::min(8, w - i0);  // doubles in this group
+    auto mask = [nd](int first) {
+      const int k = std::clamp(nd - first, 0, 8);
+      return static_cast<__mmask8>((1u << k) - 1u);
+    };
+    const double* q = row + 3 * i0;
+    const __m512d v0 = _mm512_maskz_loadu_pd(mask(0), q);
+    const __m512d v1 = _mm512_maskz_loadu_pd(mask(8), q + 8);
+    const __m512d v2 = _mm512_maskz_loadu_pd(mask(16), q + 16);
+    const __m512d vx = _mm512_permutex2var_pd(_mm512_permutex2var_pd(v0, ix1, v1), ix2, v2);
+    const __m512d vy = _mm512_permutex2var_pd(_mm512_permutex2var_pd(v0, iy1, v1), iy2, v2);
+    const __m512d vz = _mm512_permutex2var_pd(_mm512_permutex2var_pd(v0, iz1, v1), iz2, v2);
+    const __m256 fx = _mm512_maskz_cvtpd_ps(0xFF, vx), fy = _mm512_maskz_cvtpd_ps(0xFF, vy);
+    const __m256 fz = _mm512_maskz_cvtpd_ps(0xFF, vz);
+    _mm256_storeu_ps(dst[0] + i0, fx);
+    _mm256_storeu_ps(dst[1] + i0, fy);
+    _mm256_storeu_ps(dst[2] + i0, fz);
+    _mm256_storeu_ps(dst[3] + i0, fx);
+    _mm256_storeu_ps(dst[4] + i0, fy);
+    _mm256_storeu_ps(dst[5] + i0, fz);
+  }
+}
+
+// row[n] += double(now[n]) - double(old[n]) for the w nodes of one row (xyz doubles).
+__attribute__((target("avx512f"))) void row_add_moves_avx512(double* row, int w, const float* const src[6]) noexcept {
+  // out0 = x0 y0 z0 x1 y1 z1 x2 y2, out1 = z2 x3 y3 z3 x4 y4 z4 x5, out2 = y5 z5 x6 y6 z6 x7 y7 z7
+  const __m512i a0 = _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), b0 = _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7);
+  const __m512i a1 = _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), b1 = _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7);
+  const __m512i a2 = _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), b2 = _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15);
+  for (int i0 = 0; i0 < w; i0 += 8) {
+    const int nd = 3 * std::min(8, w - i0);
+    auto mask = [nd](int first) {
+      const int k = std::clamp(nd - first, 0, 8);
+      return static_cast<__mmask8>((1u << k) - 1u);
+    };
+    __m512d d[3];
+    for (int c = 0; c < 3; ++c)
+      d[c] = _mm512_sub_pd(_mm512_maskz_cvtps_pd(0xFF, _mm256_loadu_ps(src[c] + i0)),
+                           _mm512_maskz_cvtps_pd(0xFF, _mm256_loadu_ps(src[c + 3] + i0)));
+    const __m512d dx = d[0], dy = d[1], dz = d[2];
+    const __m512d o0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(dx, a0, dy), b0, dz);
+    const __m512d o1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(dx, a1, dy), b1, dz);
+    const __m512d o2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(dx, a2, dy), b2, dz);
+    double* q = row + 3 * i0;
+    const __mmask8 m0 = mask(0), m1 = mask(8), m2 = mask(16);
+    _mm512_mask_storeu_pd(q, m0, _mm512_add_pd(_mm512_maskz_loadu_pd(m0, q), o0));
+    _mm512_mask_storeu_pd(q + 8, m1, _mm512_add_pd(_mm512_maskz_loadu_pd(m1, q + 8), o1));
+    _mm512_mask_storeu_pd(q + 16, m2, _mm512_add_pd(_mm512_maskz_loadu_pd(m2, q + 16), o2));
+  }
+}
+
 bool cpu_has_avx2_fma() noexcept {
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
@@ -139,6 +198,8 @@ bool cpu_has_avx512f() noexcept {
   return __builtin_cpu_supports("avx512f");
 }
 #else
+void row_to_floats_avx512(const double*, int, float* const*) noexcept {}
+void row_add_moves_avx512(double*, int, const float* const*) noexcept {}
 void project_batch_avx2(const LinkKernel::Batch& bt, const Arrays& r) noexcept { project_batch_scalar(bt, r); }
 void project_batch_avx512(const LinkKernel::Batch& bt, const Arrays& r) noexcept { project_batch_scalar(bt, r); }
 bool cpu_has_avx2_fma() noexcept { return false; }
@@ -237,13 +298,14 @@ void LinkKernel::configure(const Topology& topo, int max_simd_width) {
   int extent[2] = {h_ * lay_[0].stride, w_ * lay_[1].stride};
   std::vector<Batch> batch_of_build;
   for (const Build& b : builds) {
-    const int lanes = (b.hi - b.lo + kVec16) / kVec16 * kVec16;
+    const int a0 = b.lo / kVec16 * kVec16;  // aligned: a-node blocks are whole cache lines
+    const int lanes = (b.hi - a0 + kVec16) / kVec16 * kVec16;
     const int width = width_of(b.d);
-    const Batch bt{b.lo, b.d, lanes, data, width, block_step(b.d, width)};
+    const Batch bt{a0, b.d, lanes, data, width, block_step(b.d, width)};
     lay_[b.layout].batches.push_back(bt);
     batch_of_build.push_back(bt);
     data += lanes;
-    extent[b.layout] = std::max(extent[b.layout], b.lo + lanes + b.d);
+    extent[b.layout] = std::max(extent[b.layout], a0 + lanes + b.d);
   }
   for (int k = 0; k < m; ++k) {
     const Batch& bt = batch_of_build[link_build[k]];
@@ -263,9 +325,9 @@ void LinkKernel::configure(const Topology& topo, int max_simd_width) {
     lay_[0].py.assign(extent[0], 0.0f);
     lay_[0].pz.assign(extent[0], 0.0f);
   }
-  ox_.assign(topo.grid.count(), 0.0f);
-  oy_.assign(topo.grid.count(), 0.0f);
-  oz_.assign(topo.grid.count(), 0.0f);
+  ox_.assign(lay_[0].px.size(), 0.0f);
+  oy_.assign(lay_[0].px.size(), 0.0f);
+  oz_.assign(lay_[0].px.size(), 0.0f);
 }
 
 void LinkKernel::force_scalar(bool on) noexcept { use_simd_ = has_avx2_ && !on; }
@@ -292,21 +354,31 @@ void LinkKernel::run(Layout& lay) noexcept {
 }
 
 void LinkKernel::project_rt(std::span<Vec3> x) noexcept {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is read as 3 packed doubles");
+  if (static_cast<int>(x.size()) < w_ * h_ || w_ * h_ == 0) return;
   // Padding nodes are reset to 0 every pass so nothing can accumulate in them.
   Layout& l0 = lay_[0];
   std::fill(l0.px.begin(), l0.px.end(), 0.0f);
   std::fill(l0.py.begin(), l0.py.end(), 0.0f);
   std::fill(l0.pz.begin(), l0.pz.end(), 0.0f);
-  for (int j = 0, n = 0; j < h_; ++j) {
-    for (int i = 0; i < w_; ++i, ++n) {
-      const int p = l0.index(i, j);
-      l0.px[p] = ox_[n] = static_cast<float>(x[n].x);
-      l0.py[p] = oy_[n] = static_cast<float>(x[n].y);
-      l0.pz[p] = oz_[n] = static_cast<float>(x[n].z);
+  double* xd = &x[0].x;
+  if (has_avx512_) {
+    for (int j = 0; j < h_; ++j) {
+      const int p = l0.index(0, j);
+      float* const dst[6] = {&l0.px[p], &l0.py[p], &l0.pz[p], &ox_[p], &oy_[p], &oz_[p]};
+      row_to_floats_avx512(xd + 3 * static_cast<std::ptrdiff_t>(j) * w_, w_, dst);
+    }
+  } else {
+    for (int j = 0, n = 0; j < h_; ++j) {
+      for (int i = 0; i < w_; ++i, ++n) {
+        const int p = l0.index(i, j);
+        l0.px[p] = ox_[p] = static_cast<float>(x[n].x);
+        l0.py[p] = oy_[p] = static_cast<float>(x[n].y);
+        l0.pz[p] = oz_[p] = static_cast<float>(x[n].z);
+      }
     }
   }
   run(l0);
-  const Layout* last = &l0;
   Layout& l1 = lay_[1];
   if (!l1.batches.empty()) {
     std::fill(l1.px.begin(), l1.px.end(), 0.0f);
@@ -321,14 +393,29 @@ void LinkKernel::project_rt(std::span<Vec3> x) noexcept {
       }
     }
     run(l1);
-    last = &l1;
+    for (int i = 0; i < w_; ++i) {  // back to layout 0
+      for (int j = 0; j < h_; ++j) {
+        const int p = l0.index(i, j), q = l1.index(i, j);
+        l0.px[p] = l1.px[q];
+        l0.py[p] = l1.py[q];
+        l0.pz[p] = l1.pz[q];
+      }
+    }
   }
-  for (int j = 0, n = 0; j < h_; ++j) {
-    for (int i = 0; i < w_; ++i, ++n) {
-      const int p = last->index(i, j);
-      x[n].x += static_cast<double>(last->px[p]) - static_cast<double>(ox_[n]);
-      x[n].y += static_cast<double>(last->py[p]) - static_cast<double>(oy_[n]);
-      x[n].z += static_cast<double>(last->pz[p]) - static_cast<double>(oz_[n]);
+  if (has_avx512_) {
+    for (int j = 0; j < h_; ++j) {
+      const int p = l0.index(0, j);
+      const float* const src[6] = {&l0.px[p], &l0.py[p], &l0.pz[p], &ox_[p], &oy_[p], &oz_[p]};
+      row_add_moves_avx512(xd + 3 * static_cast<std::ptrdiff_t>(j) * w_, w_, src);
+    }
+  } else {
+    for (int j = 0, n = 0; j < h_; ++j) {
+      for (int i = 0; i < w_; ++i, ++n) {
+        const int p = l0.index(i, j);
+        x[n].x += static_cast<double>(l0.px[p]) - static_cast<double>(ox_[p]);
+        x[n].y += static_cast<double>(l0.py[p]) - static_cast<double>(oy_[p]);
+        x[n].z += static_cast<double>(l0.pz[p]) - static_cast<double>(oz_[p]);
+      }
     }
   }
 }

@@ -10,14 +10,19 @@
 // runtime CPU check; the batch is swept block by block, which is one Gauss-Seidel order.
 // Links whose row-major D is short (along a row, or D < 16 with AVX-512) go to a second,
 // transposed layout (node (i, j) at i*S' + j, S' >= H) when their offset is wider there:
-// the pass runs the row-major batches, copies the positions across, then runs the
-// transposed ones. Links that fit neither run lane by lane, as does every batch on a CPU
+// the pass runs the row-major batches, copies the positions across, runs the transposed
+// ones and copies them back. Positions go in and the moves come back 8 nodes at a time with
+// AVX-512 (permutes between xyz doubles and float arrays) when the CPU has it. Links that fit neither run lane by lane, as does every batch on a CPU
 // without AVX2+FMA (same order). A topology that repeats an offset/pair gets extra batches.
 //
 // Configure-time: configure(). RT: everything else (no allocation).
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <new>
 #include <span>
 #include <vector>
 
@@ -51,7 +56,7 @@ class LinkKernel {
   [[nodiscard]] int lane_count() const noexcept { return static_cast<int>(rest_.size()); }
 
   struct Batch {
-    std::int32_t a0;     // padded index of lane 0's a-node
+    std::int32_t a0;     // padded index of lane 0's a-node, a multiple of 16
     std::int32_t d;      // b-node = a-node + d
     std::int32_t lanes;  // a multiple of 8
     std::int32_t data;   // first lane's slot in rest_/wa_/wb_
@@ -60,11 +65,36 @@ class LinkKernel {
   };
 
  private:
+  // A float array on a 64-byte boundary (whole AVX-512 vectors load without a cache-line
+  // split when the index is a multiple of 16). assign() allocates (configure time).
+  class AlignedFloats {
+   public:
+    void assign(std::size_t n, float v) {
+      p_.reset(n > 0 ? static_cast<float*>(::operator new[](n * sizeof(float), std::align_val_t{64})) : nullptr);
+      n_ = n;
+      std::fill_n(p_.get(), n, v);
+    }
+    [[nodiscard]] float* data() noexcept { return p_.get(); }
+    [[nodiscard]] const float* data() const noexcept { return p_.get(); }
+    [[nodiscard]] std::size_t size() const noexcept { return n_; }
+    [[nodiscard]] bool empty() const noexcept { return n_ == 0; }
+    float* begin() noexcept { return p_.get(); }
+    float* end() noexcept { return p_.get() + n_; }
+    float& operator[](std::size_t i) noexcept { return p_[i]; }
+    const float& operator[](std::size_t i) const noexcept { return p_[i]; }
+
+   private:
+    struct Free {
+      void operator()(float* p) const noexcept { ::operator delete[](p, std::align_val_t{64}); }
+    };
+    std::unique_ptr<float[], Free> p_;
+    std::size_t n_ = 0;
+  };
   struct Layout {
     int stride = 0;
     bool transposed = false;
     std::vector<Batch> batches;
-    std::vector<float> px, py, pz;  // padded positions
+    AlignedFloats px, py, pz;  // padded positions
     [[nodiscard]] int index(int i, int j) const noexcept { return transposed ? i * stride + j : j * stride + i; }
   };
   void run(Layout& lay) noexcept;
@@ -74,8 +104,8 @@ class LinkKernel {
   Layout lay_[2];                       // row-major, transposed
   std::vector<std::int32_t> lane_;      // per link: its lane slot
   std::vector<std::uint8_t> flipped_;   // per link: 1 when topo.a is the lane's b-node
-  std::vector<float> rest_, wa_, wb_;   // per lane slot
-  std::vector<float> ox_, oy_, oz_;     // per node: the values copied in
+  AlignedFloats rest_, wa_, wb_;        // per lane slot
+  AlignedFloats ox_, oy_, oz_;          // layout 0: the values copied in (for the add-back)
 };
 
 }  // namespace crease::sheet

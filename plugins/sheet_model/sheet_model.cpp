@@ -58,6 +58,12 @@ SheetModel::SheetModel(const SheetParams& params)
   target_stencil_.resize(kMaxTargets);
   keypoint_gain_ = s.keypoint_gain_per_s;
   restore_link_stiffness();
+  saved_rest_ = rest_;
+  saved_plastic_ = plastic_;
+  saved_stiffness_ = stiffness_;
+  saved_compliance_ = compliance_;
+  saved_creases_ = creases_;
+  saved_version_ = links_version_;
 }
 
 Vec3 SheetModel::flat_position(Vec2 p) const noexcept {
@@ -225,6 +231,29 @@ void SheetModel::compute_strains(std::span<double> out) const noexcept {
     const double l = rest_[k] + plastic_[k];
     out[k] = l > 0 ? (norm(x[topo_.b[k]] - x[topo_.a[k]]) - l) / l : 0.0;
   }
+}
+
+void SheetModel::save_links_rt() noexcept {
+  if (saved_version_ != links_version_) {
+    std::copy(rest_.begin(), rest_.end(), saved_rest_.begin());
+    std::copy(stiffness_.begin(), stiffness_.end(), saved_stiffness_.begin());
+    std::copy(compliance_.begin(), compliance_.end(), saved_compliance_.begin());
+    std::copy(plastic_.begin(), plastic_.end(), saved_plastic_.begin());
+    saved_creases_ = creases_;
+    saved_version_ = links_version_;
+  } else if (params_.solver.plasticity_rate > 0) {
+    std::copy(plastic_.begin(), plastic_.end(), saved_plastic_.begin());
+  }
+}
+
+void SheetModel::restore_links_rt() noexcept {
+  std::copy(saved_rest_.begin(), saved_rest_.end(), rest_.begin());
+  std::copy(saved_stiffness_.begin(), saved_stiffness_.end(), stiffness_.begin());
+  std::copy(saved_compliance_.begin(), saved_compliance_.end(), compliance_.begin());
+  std::copy(saved_plastic_.begin(), saved_plastic_.end(), plastic_.begin());
+  creases_ = saved_creases_;
+  ++links_version_;  // backends re-read rest lengths and compliances
+  saved_version_ = links_version_;
 }
 
 bool SheetModel::state_finite() const noexcept {

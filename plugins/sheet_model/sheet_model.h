@@ -110,6 +110,14 @@ class SheetModel {
   // (backends re-read them).
   [[nodiscard]] std::uint64_t links_version() const noexcept { return links_version_; }
 
+  // The link state (rest lengths, plastic elongations, stiffnesses, creases) kept for a
+  // rollback: save_links_rt copies what changed since the last save (rest lengths,
+  // stiffnesses and creases when links_version() moved; plastic elongations every time
+  // plasticity is on, as the step updates them); restore_links_rt puts the saved copy back
+  // (backends re-read it). Positions are the caller's (set_positions). RT, no allocation.
+  void save_links_rt() noexcept;
+  void restore_links_rt() noexcept;
+
  protected:
   void restore_link_stiffness() noexcept;  // default stiffness, then every crease applied
   [[nodiscard]] double link_base_compliance(int link) const noexcept;
@@ -134,6 +142,11 @@ class SheetModel {
   double keypoint_gain_ = 10.0;
   const CollisionWorld* world_ = nullptr;
   std::uint64_t links_version_ = 0;
+
+ private:
+  std::vector<double> saved_rest_, saved_plastic_, saved_stiffness_, saved_compliance_;
+  CreaseSet saved_creases_;
+  std::uint64_t saved_version_ = ~std::uint64_t{0};
 };
 
 }  // namespace crease::sheet

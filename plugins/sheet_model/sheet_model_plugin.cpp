@@ -4,12 +4,13 @@
 //        crease (queue, SheetCreaseEvent), memorize (queue, SheetMemorizeEvent),
 //        reset (queue, SheetResetEvent)
 //   out: sheet_state (latest, SheetState)
-// A step that leaves the state non-finite is rolled back to the last good state and the
-// update returns degraded (counted in sheet_state.rollbacks).
+// A step that leaves the state non-finite is rolled back to the state it started from
+// (positions and link state) and the update returns degraded (counted in
+// sheet_state.rollbacks).
 // Parameters (all optional): nodes_u, nodes_v, width_mm, height_mm, density_g_per_m2,
 // thickness_mm, origin_x_mm, origin_y_mm, origin_z_mm, substeps, keypoint_gain_per_s, target_compliance_m_per_n,
 // compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
-// self_collision (0/1).
+// self_collision (0/1), self_collision_every (1..100 substeps; the last substep always).
 #include <memory>
 
 #include "core/plugin.h"
@@ -44,6 +45,8 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.yield_strain = p.get_in_range<double>("yield_strain", 0.0, 0.0, 1.0);
     sp.solver.plasticity_rate = p.get_in_range<double>("plasticity_rate", 0.0, 0.0, 0.99);
     sp.solver.self_collision = p.get_in_range<int>("self_collision", 1, 0, 1) != 0;
+    // Layer contacts enforced every this many substeps (and always on the last one).
+    sp.solver.self_collision_every = p.get_in_range<int>("self_collision_every", 2, 1, 100);
     const double table = p.get_in_range<double>("table_height_mm", 0.0, -1e4, 1e4);
     runner_ = std::make_unique<sheet::SheetRunner>(sp, table);
     state_ = std::make_unique<SheetState>();

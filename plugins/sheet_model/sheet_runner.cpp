@@ -86,12 +86,14 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
   observations_ = static_cast<std::uint32_t>(n);
   for (int i = 0; i < n_external_ && n < static_cast<int>(predicted_.size()); ++i) predicted_[n++] = external_[i];
   model_->set_targets(std::span<const TargetPoint>(predicted_.data(), n));
+  model_->save_links_rt();  // with last_good_: the state this step starts from
   model_->step_rt(dt_s);
   ++steps_;
   bool ok = model_->state_finite();
   if (ok) {
     for (std::size_t i = 0; i < last_good_.size(); ++i) last_good_[i] = model_->positions()[i];
   } else {
+    model_->restore_links_rt();
     model_->set_positions(last_good_);
     ++rollbacks_;
   }

@@ -1,7 +1,8 @@
 // The sheet model as one loop step, independent of the plugin ABI (the plugin wrapper is a
 // thin shell around this; tests drive it directly): observations and model edits in, a
-// SheetState out. A step that leaves the state non-finite is rolled back to the last good
-// state and reported, never propagated. Everything is allocated in the constructor.
+// SheetState out. A step that leaves the state non-finite is rolled back to the state it
+// started from (positions, zero velocities, rest lengths, plastic elongations, stiffnesses,
+// creases) and reported, never propagated. Everything is allocated in the constructor.
 #pragma once
 
 #include <array>

@@ -3,20 +3,71 @@
 #include <algorithm>
 #include <cmath>
 
+#include "collision_world.h"
+#include "node_passes.h"
 #include "plasticity.h"
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace crease::sheet {
+namespace {
+
+// One Gauss-Seidel pass over the target rows (see project_targets) with each node's xyz in
+// one AVX2 register (masked to 3 lanes). The 4 nodes of a row are distinct (a grid cell).
+#if defined(__x86_64__)
+template <class Row>
+__attribute__((target("avx2,fma"))) void project_targets_avx2(Vec3* x, const Row* rows, int n) noexcept {
+  const __m256i m3 = _mm256_setr_epi64x(-1, -1, -1, 0);
+  for (int t = 0; t < n; ++t) {
+    const Row& r = rows[t];
+    if (!(r.inv_den > 0)) continue;
+    // Written out (no arrays): the loads and stores stay in registers.
+    double* const p0 = &x[r.node[0]].x;
+    double* const p1 = &x[r.node[1]].x;
+    double* const p2 = &x[r.node[2]].x;
+    double* const p3 = &x[r.node[3]].x;
+    const __m256d q0 = _mm256_maskload_pd(p0, m3), q1 = _mm256_maskload_pd(p1, m3);
+    const __m256d q2 = _mm256_maskload_pd(p2, m3), q3 = _mm256_maskload_pd(p3, m3);
+    __m256d c = _mm256_mul_pd(_mm256_set1_pd(r.b[0]), q0);
+    c = _mm256_fmadd_pd(_mm256_set1_pd(r.b[1]), q1, c);
+    c = _mm256_fmadd_pd(_mm256_set1_pd(r.b[2]), q2, c);
+    c = _mm256_fmadd_pd(_mm256_set1_pd(r.b[3]), q3, c);
+    const __m256d w = _mm256_setr_pd(r.world.x, r.world.y, r.world.z, 0.0);
+    const __m256d err = _mm256_mul_pd(_mm256_set1_pd(r.inv_den), _mm256_sub_pd(c, w));
+    _mm256_maskstore_pd(p0, m3, _mm256_fnmadd_pd(_mm256_set1_pd(r.wb[0]), err, q0));
+    _mm256_maskstore_pd(p1, m3, _mm256_fnmadd_pd(_mm256_set1_pd(r.wb[1]), err, q1));
+    _mm256_maskstore_pd(p2, m3, _mm256_fnmadd_pd(_mm256_set1_pd(r.wb[2]), err, q2));
+    _mm256_maskstore_pd(p3, m3, _mm256_fnmadd_pd(_mm256_set1_pd(r.wb[3]), err, q3));
+  }
+}
+bool cpu_has_avx2_fma() noexcept {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+#else
+template <class Row>
+void project_targets_avx2(Vec3*, const Row*, int) noexcept {}
+bool cpu_has_avx2_fma() noexcept { return false; }
+#endif
+
+}  // namespace
 
 XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
   const int n = node_count();
   x_ = flat_;
   v_.assign(n, Vec3{});
   prev_ = flat_;
+  x_detect_ = flat_;
   kvel_.assign(n, Vec3{});
   kweight_.assign(n, 0.0);
   w_.assign(n, 0.0);
   target_rows_.resize(kMaxTargets);
   kernel_.configure(topo_);
+  cpu_simd_ = cpu_has_avx2_fma() && node_passes_simd_available();
+  simd_ = cpu_simd_;
+  keep_.assign(3 * static_cast<std::size_t>(n), -1);
   const SolverParams& s = params_.solver;
   if (s.plasticity_rate > 0) {
     for (int k = 0; k < link_count(); ++k)
@@ -32,6 +83,7 @@ void XpbdSheet::set_positions(std::span<const Vec3> pos) noexcept {
     prev_[i] = pos[i];
     v_[i] = Vec3{};
   }
+  detect_margin_mm_ = -1.0;
 }
 
 void XpbdSheet::prepare_frame(double dt_s) noexcept {
@@ -39,7 +91,10 @@ void XpbdSheet::prepare_frame(double dt_s) noexcept {
   prepared_version_ = links_version_;
   prepared_dt_ = dt_s;
   const double inv_dts2 = 1.0 / (dt_s * dt_s);
-  for (int i = 0; i < node_count(); ++i) w_[i] = pinned_[i] ? 0.0 : 1.0 / mass_[i];
+  for (int i = 0; i < node_count(); ++i) {
+    w_[i] = pinned_[i] ? 0.0 : 1.0 / mass_[i];
+    for (int c = 0; c < 3; ++c) keep_[3 * i + c] = pinned_[i] ? 0 : -1;
+  }
   for (int k = 0; k < link_count(); ++k) {
     const double wa = w_[topo_.a[k]], wb = w_[topo_.b[k]];
     const double den = wa + wb + compliance_[k] * inv_dts2;
@@ -83,25 +138,36 @@ void XpbdSheet::project_links() noexcept {
 // seed 001 Eq. 4, generalised to a bilinear sheet point c = sum b_e x_e:
 // x_e -= w_e b_e (c - x_d) / (sum w_e b_e^2 + alpha_input / dt_s^2).
 // The weights are fixed within a frame: computed once, applied every substep.
+// Rows are stored in the order t = r, r + K, r + 2K, ... for r < K: key-points of one
+// marker arrive together and share stencil nodes, so neighbours in that order seldom
+// share a node and consecutive projections do not wait for each other's stores.
 void XpbdSheet::prepare_targets(double dt_s) noexcept {
+  constexpr int kInterleave = 7;
   const double at = params_.solver.target_compliance_m_per_n / (dt_s * dt_s);
-  for (int t = 0; t < n_targets_; ++t) {
-    const SheetPointStencil& s = target_stencil_[t];
-    TargetRow& r = target_rows_[t];
-    double den = at;
-    for (int e = 0; e < 4; ++e) {
-      r.node[e] = s.node[e];
-      r.b[e] = s.bilinear[e];
-      r.wb[e] = w_[s.node[e]] * s.bilinear[e];
-      den += r.wb[e] * s.bilinear[e];
+  int row = 0;
+  for (int first = 0; first < kInterleave; ++first) {
+    for (int t = first; t < n_targets_; t += kInterleave) {
+      const SheetPointStencil& s = target_stencil_[t];
+      TargetRow& r = target_rows_[row++];
+      double den = at;
+      for (int e = 0; e < 4; ++e) {
+        r.node[e] = s.node[e];
+        r.b[e] = s.bilinear[e];
+        r.wb[e] = w_[s.node[e]] * s.bilinear[e];
+        den += r.wb[e] * s.bilinear[e];
+      }
+      r.inv_den = den > 0 ? 1.0 / den : 0.0;
+      r.world = targets_[t].world_mm;
     }
-    r.inv_den = den > 0 ? 1.0 / den : 0.0;
-    r.world = targets_[t].world_mm;
   }
 }
 
 void XpbdSheet::project_targets() noexcept {
   Vec3* x = x_.data();
+  if (simd_) {
+    project_targets_avx2(x, target_rows_.data(), n_targets_);
+    return;
+  }
   for (int t = 0; t < n_targets_; ++t) {
     const TargetRow r = target_rows_[t];  // a copy: the stores to x cannot alias it
     if (!(r.inv_den > 0)) continue;
@@ -122,6 +188,34 @@ void XpbdSheet::update_plasticity() noexcept {
   }
 }
 
+void XpbdSheet::detect_contacts(double dt) noexcept {
+  const int n = node_count();
+  double vmax2 = 0, moved2 = 0;
+  for (int i = 0; i < n; ++i) {
+    vmax2 = std::max(vmax2, dot(v_[i], v_[i]));
+    const Vec3 d = x_[i] - x_detect_[i];
+    moved2 = std::max(moved2, dot(d, d));
+  }
+  const double frame_move = 1.5 * std::sqrt(vmax2) * dt;
+  const double frame_margin = std::min(2.0 + frame_move, 30.0);  // the per-frame rule
+  const std::uint64_t wv = world_ != nullptr ? world_->version() : 0;
+  const bool valid = detect_margin_mm_ >= 0 && world_ == detect_world_ && wv == detect_world_version_ &&
+                     2.0 + std::sqrt(moved2) + frame_move <= detect_margin_mm_;
+  if (valid) {
+    contacts_.select_rt(x_, frame_margin);
+    return;
+  }
+  const double margin = std::min(2.0 + frame_move + kContactSkinMm, 30.0);
+  // Layer contacts also a skin's move beside a triangle: nodes slide along the other layer.
+  contacts_.detect_rt(x_, world_, margin, margin - frame_margin);
+  contacts_.select_rt(x_, frame_margin);
+  std::copy(x_.begin(), x_.end(), x_detect_.begin());
+  detect_margin_mm_ = margin;
+  detect_world_ = world_;
+  detect_world_version_ = wv;
+  ++detections_;
+}
+
 void XpbdSheet::step_rt(double dt) noexcept {
   if (!(dt > 0) || !std::isfinite(dt)) return;
   const SolverParams& sp = params_.solver;
@@ -129,44 +223,18 @@ void XpbdSheet::step_rt(double dt) noexcept {
   const double dts = dt / ns;
   prepare_frame(dts);
   prepare_targets(dts);
-  const int n = node_count();
-  // Collision candidates once per frame, with a margin covering this frame's motion.
-  double vmax = 0;
-  for (int i = 0; i < n; ++i) vmax = std::max(vmax, norm(v_[i]));
-  const double margin = std::min(2.0 + 1.5 * vmax * dt, 30.0);
-  contacts_.detect_rt(x_, world_, margin);
+  detect_contacts(dt);
 
   const double damp = std::max(0.0, 1.0 - sp.damping_per_s * dts);
   const double vcap = sp.max_speed_mm_per_s;
   for (int s = 0; s < ns; ++s) {
     apply_keypoint_velocities(dts);
-    for (int i = 0; i < n; ++i) {  // seed 001 Eq. 1
-      prev_[i] = x_[i];
-      if (pinned_[i]) {
-        x_[i] = pin_pos_[i];
-        continue;
-      }
-      v_[i] = damp * (v_[i] + dts * sp.gravity_mm_per_s2);
-      x_[i] += dts * v_[i];
-    }
+    predict_rt(x_, v_, prev_, pin_pos_, keep_, sp.gravity_mm_per_s2, damp, dts, simd_);  // seed 001 Eq. 1
     project_links();
     project_targets();
     const int every = std::max(1, sp.self_collision_every);
     contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);
-    const double inv = 1.0 / dts;
-    for (int i = 0; i < n; ++i) {
-      if (pinned_[i]) {
-        v_[i] = Vec3{};
-        continue;
-      }
-      Vec3 v = inv * (x_[i] - prev_[i]);
-      const double sp2 = dot(v, v);
-      if (sp2 > vcap * vcap) {  // speed limit: the move of this substep is shortened too
-        v *= vcap / std::sqrt(sp2);
-        x_[i] = prev_[i] + dts * v;
-      }
-      v_[i] = v;
-    }
+    update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit
     if (!plastic_links_.empty()) update_plasticity();
   }
 }

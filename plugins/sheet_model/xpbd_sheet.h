@@ -6,7 +6,16 @@
 //   solver.self_collision_every substeps and on the last) -> velocities from positions ->
 //   plastic update (seed 001 III.C).
 // Link constants are rebuilt only when links_version() or dt_s change; target-spring
-// weights once per frame; contact candidates once per frame.
+// weights once per frame (rows interleaved so consecutive ones seldom share a node).
+// Contacts: candidates are detected with a margin that also covers a skin of motion (and,
+// for layers, the skin beside each triangle) and kept over frames while 2 mm + the largest
+// node move since the detection + 1.5 x this frame's largest possible move stays within
+// that margin (the per-frame rule, 2 mm + 1.5 x the frame's move, over the whole time they
+// are used); detected again when it does not, when the collision world changed (version())
+// or after set_positions. Every frame, the candidates that pass the per-frame rule are the
+// active ones (ContactSolver::select_rt), each layer contact taking the node's current side.
+// Prediction, velocities and target springs run 4 doubles at a time (AVX2+FMA, runtime
+// check; force_scalar_passes for tests).
 // Storage is allocated in the constructor; step_rt allocates nothing.
 #pragma once
 
@@ -32,6 +41,8 @@ class XpbdSheet final : public SheetModel {
   [[nodiscard]] const ContactStats& contact_stats() const noexcept { return contacts_.stats(); }
   [[nodiscard]] const LinkKernel& link_kernel() const noexcept { return kernel_; }
   LinkKernel& link_kernel() noexcept { return kernel_; }
+  // The target and per-node passes without AVX2 even when the CPU has it (tests compare).
+  void force_scalar_passes(bool on) noexcept { simd_ = !on && cpu_simd_; }
 
  private:
   void prepare_frame(double dt_s) noexcept;
@@ -40,6 +51,7 @@ class XpbdSheet final : public SheetModel {
   void prepare_targets(double dt_s) noexcept;
   void project_targets() noexcept;
   void update_plasticity() noexcept;
+  void detect_contacts(double dt_s) noexcept;
 
   std::vector<Vec3> x_, v_, prev_, kvel_;
   std::vector<double> kweight_;
@@ -51,11 +63,24 @@ class XpbdSheet final : public SheetModel {
     Vec3 world;             // target, mm
   };
   std::vector<TargetRow> target_rows_;  // capacity kMaxTargets
+  bool cpu_simd_ = false, simd_ = false;  // AVX2+FMA target and per-node passes (runtime check)
+  std::vector<std::int64_t> keep_;       // per xyz component: -1 free node, 0 pinned (node_passes.h)
   LinkKernel kernel_;                        // link data, refreshed when links_version() or dt_s change
   std::uint64_t prepared_version_ = ~std::uint64_t{0};
   double prepared_dt_ = 0.0;
   std::vector<std::int32_t> plastic_links_;  // elasto-plastic links
   ContactSolver contacts_;
+  std::vector<Vec3> x_detect_;       // positions at the last contact detection
+  double detect_margin_mm_ = -1.0;   // margin of the last detection; < 0: detect next frame
+  const CollisionWorld* detect_world_ = nullptr;
+  std::uint64_t detect_world_version_ = 0;
+  std::uint64_t detections_ = 0;
+
+ public:
+  // Extra motion the contact candidates cover, mm (0: found again every frame).
+  static constexpr double kContactSkinMm = 8.0;
+  // Contact detections since construction (tests, benchmark).
+  [[nodiscard]] std::uint64_t contact_detections() const noexcept { return detections_; }
 };
 
 }  // namespace crease::sheet

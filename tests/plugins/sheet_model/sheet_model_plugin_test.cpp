@@ -62,3 +62,21 @@ TEST_CASE_FIXTURE(Fixture, "the plugin publishes a finite sheet state and alloca
   CHECK(crease::rt::rt_allocation_count() == before);
   host.stop();
 }
+
+TEST_CASE("self_collision_every is a validated parameter, named in the error") {
+  crease::PluginHost host{{CREASE_PLUGIN_DIR}};
+  host.add_loop({"model", 120.0, 0, -1});
+  auto spec = [](const char* yaml) {
+    crease::InstanceSpec s;
+    s.name = "sheet";
+    s.library = "sheet_model";
+    s.loop = "model";
+    s.params = crease::Params(YAML::Load(yaml), "test.yaml", "sheet.params");
+    return s;
+  };
+  CHECK_THROWS_WITH_AS(host.add_instance(spec("{substeps: 4, self_collision_every: 0}")),
+                       doctest::Contains("self_collision_every"), std::exception);
+  CHECK_THROWS_WITH_AS(host.add_instance(spec("{substeps: 4, self_collision_every: 1000}")),
+                       doctest::Contains("self_collision_every"), std::exception);
+  CHECK_NOTHROW(host.add_instance(spec("{substeps: 4, self_collision_every: 1}")));
+}

@@ -113,6 +113,73 @@ TEST_CASE("a non-finite step is rolled back to the last good state and counted")
   CHECK(state->all_finite());
 }
 
+// Like PoisonedSheet, and its bad step also damages the link state a step may change.
+class PoisonedLinksSheet final : public SheetModel {
+ public:
+  explicit PoisonedLinksSheet(const SheetParams& p) : SheetModel(p), x_(flat_), v_(flat_.size()) {}
+  void step_rt(double dt_s) noexcept override {
+    for (Vec3& x : x_) x.z -= 10.0 * dt_s;
+    for (double& d : plastic_) d += 0.001;  // a legitimate plastic update every step
+    if (++steps_ == 3) {
+      x_[7].y = std::nan("");
+      rest_[5] = std::nan("");
+      plastic_[5] = 1e9;
+      stiffness_[5] = 0.123;
+      compliance_[5] = std::nan("");
+    }
+  }
+  std::span<const Vec3> positions() const noexcept override { return x_; }
+  std::span<const Vec3> velocities() const noexcept override { return v_; }
+  void set_positions(std::span<const Vec3> p) noexcept override {
+    for (std::size_t i = 0; i < x_.size() && i < p.size(); ++i) x_[i] = p[i];
+  }
+  const char* backend_name() const noexcept override { return "poisoned-links"; }
+
+ private:
+  std::vector<Vec3> x_, v_;
+  int steps_ = 0;
+};
+
+TEST_CASE("a rollback restores the link state too: rest lengths, plastic elongation, stiffness, creases") {
+  SheetParams p;
+  p.solver.plasticity_rate = 0.3;
+  p.solver.yield_strain = 0.01;
+  SheetRunner r(std::make_unique<PoisonedLinksSheet>(p));
+  SheetModel& m = r.model();
+  auto state = std::make_unique<crease::SheetState>();
+  CHECK(r.step_rt(1.0 / 60, 0, *state));
+  CHECK(r.step_rt(1.0 / 60, kFrameNs, *state));
+  // A crease arrives before the bad step: it is part of the state that step starts from.
+  crease::SheetCreaseEvent ce{};
+  ce.op = crease::SheetCreaseEvent::Op::add;
+  ce.a_mm[0] = 0;
+  ce.a_mm[1] = 148.5;
+  ce.b_mm[0] = 210;
+  ce.b_mm[1] = 148.5;
+  r.apply(ce);
+  REQUIRE(m.creases().count() == 1);
+  const std::vector<double> rest(m.rest_lengths().begin(), m.rest_lengths().end());
+  const std::vector<double> plastic(m.plastic_elongations().begin(), m.plastic_elongations().end());
+  const std::vector<double> stiff(m.stiffnesses().begin(), m.stiffnesses().end());
+  REQUIRE(plastic[5] == doctest::Approx(0.002));
+  const std::uint64_t version = m.links_version();
+  CHECK_FALSE(r.step_rt(1.0 / 60, 2 * kFrameNs, *state));  // the poisoned step
+  CHECK(r.rollbacks() == 1);
+  CHECK(m.links_version() != version);  // backends re-read the restored links
+  CHECK(m.creases().count() == 1);
+  bool same = true;
+  for (std::size_t k = 0; k < rest.size(); ++k) {
+    same = same && m.rest_lengths()[k] == rest[k] && m.plastic_elongations()[k] == plastic[k] &&
+           m.stiffnesses()[k] == stiff[k];
+  }
+  CHECK(same);
+  CHECK(m.rest_lengths()[5] == rest[5]);
+  CHECK(m.plastic_elongations()[5] == plastic[5]);
+  CHECK(m.stiffnesses()[5] == stiff[5]);
+  CHECK(r.step_rt(1.0 / 60, 3 * kFrameNs, *state));  // and it goes on from there
+  CHECK(m.plastic_elongations()[5] == doctest::Approx(0.003));
+}
+
 TEST_CASE("absurd but finite targets are bounded by the speed limit") {
   SheetParams p;
   p.solver.substeps = 2;
