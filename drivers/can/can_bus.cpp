@@ -48,4 +48,16 @@ CanFrame make_error_frame_for_state(BusState s) noexcept {
   return f;
 }
 
+RecvResult account_received(const CanFrame& f, BusState& state, CanBusCounters& counters) noexcept {
+  if (f.is_error()) {
+    const BusState before = state;
+    state = bus_state_after_error_frame(state, f);
+    if (state == BusState::bus_off && before != BusState::bus_off) ++counters.bus_off_events;
+    ++counters.rx_error_frames;
+    return RecvResult::error_frame;
+  }
+  ++counters.rx_frames;
+  return RecvResult::frame;
+}
+
 }  // namespace crease::drivers

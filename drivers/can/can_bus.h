@@ -74,6 +74,11 @@ class CanBus {
 // given the state before it. Shared by SocketCanBus and MockCanBus.
 [[nodiscard]] BusState bus_state_after_error_frame(BusState before, const CanFrame& err) noexcept;
 
+// Accounts one received frame: an error frame moves state (counting a new bus-off) and is
+// counted in rx_error_frames (-> error_frame); a data frame in rx_frames (-> frame). Shared by
+// SocketCanBus and MockCanBus. RT-safe.
+[[nodiscard]] RecvResult account_received(const CanFrame& f, BusState& state, CanBusCounters& counters) noexcept;
+
 // Builds the error frame a controller reports for entering a state (for mocks and tests).
 [[nodiscard]] CanFrame make_error_frame_for_state(BusState s) noexcept;
 

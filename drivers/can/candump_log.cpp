@@ -6,6 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "rt/clock.h"
+
 namespace crease::drivers {
 namespace {
 constexpr char kHex[] = "0123456789ABCDEF";
@@ -29,11 +31,6 @@ std::size_t put_dec(char* p, std::uint64_t v, int min_digits) noexcept {
   return static_cast<std::size_t>(n);
 }
 
-std::int64_t mono_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
 }  // namespace
 
 std::size_t format_candump_line(const CandumpEntry& e, char* buf, std::size_t cap) noexcept {
@@ -195,7 +192,7 @@ std::size_t replay_candump(CandumpReader& log, CanBus& bus, double speed) {
     if (speed > 0) {
       if (first_log < 0) {
         first_log = e.timestamp_ns;
-        first_wall = mono_ns();
+        first_wall = rt::now_ns();
       }
       const std::int64_t due = first_wall + static_cast<std::int64_t>(static_cast<double>(e.timestamp_ns - first_log) / speed);
       timespec ts{static_cast<time_t>(due / 1'000'000'000), static_cast<long>(due % 1'000'000'000)};

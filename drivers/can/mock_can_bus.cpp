@@ -12,15 +12,10 @@
 #include <stdexcept>
 
 #include "drivers/can/mock_wire.h"
+#include "rt/clock.h"
 
 namespace crease::drivers {
-namespace {
-std::int64_t now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
-}  // namespace
+using rt::now_ns;
 
 MockCanBus::MockCanBus(MockCanBusConfig cfg) : cfg_(std::move(cfg)) {
   auto fail = [this](const char* what, int e) {
@@ -225,15 +220,7 @@ RecvResult MockCanBus::try_receive(RxFrame& out) noexcept {
   }
   out.frame = r.frame;
   out.timestamp_ns = r.timestamp_ns;
-  if (r.frame.is_error()) {
-    const BusState before = state_;
-    state_ = bus_state_after_error_frame(state_, r.frame);
-    if (state_ == BusState::bus_off && before != BusState::bus_off) ++counters_.bus_off_events;
-    ++counters_.rx_error_frames;
-    return RecvResult::error_frame;
-  }
-  ++counters_.rx_frames;
-  return RecvResult::frame;
+  return account_received(r.frame, state_, counters_);
 }
 
 void MockCanBus::restart() noexcept {

@@ -5,15 +5,9 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace crease::drivers {
-namespace {
-std::int64_t mono_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
-}  // namespace
+#include "rt/clock.h"
 
+namespace crease::drivers {
 RecordingCanBus::RecordingCanBus(CanBus& inner, const std::string& interface, std::size_t capacity)
     : inner_(inner), ring_(capacity) {
   if (interface.empty() || interface.size() >= sizeof(interface_) || capacity < 2) {
@@ -38,13 +32,13 @@ void RecordingCanBus::record(const CanFrame& f, std::int64_t ts) noexcept {
 
 SendResult RecordingCanBus::send(const CanFrame& f) noexcept {
   const SendResult r = inner_.send(f);
-  if (r == SendResult::ok) record(f, mono_ns());
+  if (r == SendResult::ok) record(f, rt::now_ns());
   return r;
 }
 
 std::size_t RecordingCanBus::send_batch(std::span<const CanFrame> frames, SendResult* last) noexcept {
   const std::size_t n = inner_.send_batch(frames, last);
-  const std::int64_t ts = mono_ns();
+  const std::int64_t ts = rt::now_ns();
   for (std::size_t i = 0; i < n; ++i) record(frames[i], ts);
   return n;
 }

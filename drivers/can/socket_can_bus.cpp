@@ -15,17 +15,14 @@
 #include <ctime>
 #include <system_error>
 
+#include "rt/clock.h"
+
 namespace crease::drivers {
 namespace {
 [[noreturn]] void fail(const std::string& ifname, const char* what, int e) {
   throw std::system_error(e, std::generic_category(), "SocketCAN '" + ifname + "': " + what);
 }
 
-std::int64_t mono_now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
 std::int64_t real_now_ns() noexcept {
   timespec ts{};
   clock_gettime(CLOCK_REALTIME, &ts);
@@ -185,7 +182,7 @@ RecvResult SocketCanBus::try_receive(RxFrame& out) noexcept {
     return RecvResult::error;
   }
   // Kernel timestamps are CLOCK_REALTIME; convert to CLOCK_MONOTONIC with the current offset.
-  out.timestamp_ns = mono_now_ns();
+  out.timestamp_ns = rt::now_ns();
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
       timespec ts;
@@ -194,15 +191,7 @@ RecvResult SocketCanBus::try_receive(RxFrame& out) noexcept {
       out.timestamp_ns += real - real_now_ns();
     }
   }
-  if (out.frame.is_error()) {
-    const BusState before = state_;
-    state_ = bus_state_after_error_frame(state_, out.frame);
-    if (state_ == BusState::bus_off && before != BusState::bus_off) ++counters_.bus_off_events;
-    ++counters_.rx_error_frames;
-    return RecvResult::error_frame;
-  }
-  ++counters_.rx_frames;
-  return RecvResult::frame;
+  return account_received(out.frame, state_, counters_);
 }
 
 void SocketCanBus::restart() noexcept {

@@ -2,7 +2,10 @@
 
 namespace crease::drivers {
 
-ArmHost::ArmHost(CanBus& bus, const ArmHostConfig& cfg) noexcept : bus_(bus), cfg_(cfg), monitor_(cfg.monitor) {}
+ArmHost::ArmHost(CanBus& bus, const ArmHostConfig& cfg) noexcept
+    : CanDeviceHost(bus, cfg.node, cfg.monitor, cfg.heartbeat_period_cycles, cfg.nmt_retry_cycles,
+                    cfg.restart_period_cycles),
+      cfg_(cfg) {}
 
 LinkHealth ArmHost::health() const noexcept {
   const LinkHealth h = monitor_.health();
@@ -16,42 +19,17 @@ LinkHealth ArmHost::health() const noexcept {
 
 void ArmHost::read_from_rt(std::int64_t now_ns) noexcept {
   (void)now_ns;
-  monitor_.begin_read();
   reading_.fresh = false;
-  RxFrame rx;
-  for (int i = 0; i < 256; ++i) {
-    const RecvResult r = bus_.try_receive(rx);
-    if (r == RecvResult::empty || r == RecvResult::error) break;
-    if (r != RecvResult::frame) continue;
+  read_bus([this](const RxFrame& rx) {
     arm::Status st;
-    const Decode d = arm::decode(cfg_.node, rx.frame, st);
-    if (d == Decode::ok) {
-      operational_ = st.nmt == canopen::NmtState::operational;
-      if (monitor_.on_status(st.cmd_seq, st.sync_counter, st.device_time_us)) {
-        reading_.status = st;
-        reading_.drive = cia402::state_from_statusword(st.statusword);
-        reading_.status_rx_ns = rx.timestamp_ns;
-        reading_.fresh = true;
-      }
-      continue;
-    }
-    if (d == Decode::bad_crc) {
-      monitor_.on_bad_crc();
-      continue;
-    }
-    canopen::Emcy e;
-    if (canopen::decode_emcy(rx.frame, e) && e.node == cfg_.node) {
-      // Host timeout: the drive quick-stopped itself; the state machine below re-enables it.
-      monitor_.on_emergency(e.code != canopen::kEmcyReset && e.code != canopen::kEmcyHostTimeout);
-      continue;
-    }
-    std::uint8_t node;
-    canopen::NmtState s;
-    if (canopen::decode_heartbeat(rx.frame, node, s) && node == cfg_.node) {
-      operational_ = s == canopen::NmtState::operational;
-    }
-  }
-  monitor_.end_read(bus_.state() == BusState::bus_off);
+    return take(rx.frame, st, [&](const arm::Status& s) {
+      if (!accept_status(s)) return;
+      reading_.status = s;
+      reading_.drive = cia402::state_from_statusword(s.statusword);
+      reading_.status_rx_ns = rx.timestamp_ns;
+      reading_.fresh = true;
+    });
+  });
   // A drive back in a non-fault state clears a latched joint-fault emergency.
   if (monitor_.emergency_active() && reading_.fresh && reading_.drive != cia402::State::fault &&
       reading_.drive != cia402::State::fault_reaction_active) {
@@ -61,19 +39,9 @@ void ArmHost::read_from_rt(std::int64_t now_ns) noexcept {
 
 void ArmHost::write_from_rt(const arm::Command& desired, std::int64_t now_ns) noexcept {
   (void)now_ns;
-  ++cycle_;
-  if (bus_.state() == BusState::bus_off) {
-    if (cycle_ % static_cast<std::uint64_t>(cfg_.restart_period_cycles) == 1) bus_.restart();
-    safe_sent_ = true;
-    return;
-  }
-  CanFrame out[4];  // sent as one batch
-  std::size_t n = 0;
-  if (!operational_ && cycle_ % static_cast<std::uint64_t>(cfg_.nmt_retry_cycles) == 1) {
-    out[n++] = canopen::encode_nmt(canopen::NmtCommand::start, cfg_.node);
-  }
+  if (!begin_write()) return;
   arm::Command c = desired;
-  c.seq = ++seq_;
+  c.seq = next_seq();
   const bool link_fault = monitor_.health() == LinkHealth::fault && !monitor_.emergency_active();
   using S = cia402::State;
   const S drive = reading_.drive;
@@ -104,15 +72,8 @@ void ArmHost::write_from_rt(const arm::Command& desired, std::int64_t now_ns) no
       c.velocity_rad_s[j] = 0.0f;
     }
   }
-  out[n++] = arm::encode(cfg_.node, c);
-  sync_ = canopen::next_sync_counter(sync_);
-  out[n++] = canopen::encode_sync(sync_);
-  monitor_.on_sent(c.seq, sync_);
-  if (cycle_ % static_cast<std::uint64_t>(cfg_.heartbeat_period_cycles) == 1) {
-    out[n++] = canopen::encode_heartbeat(canopen::kHostNode, canopen::NmtState::operational);
-  }
-  SendResult last;
-  send_failures_ += n - bus_.send_batch({out, n}, &last);
+  add(arm::encode(cfg_.node, c));
+  end_write(c.seq);
 }
 
 }  // namespace crease::drivers

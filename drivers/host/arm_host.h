@@ -6,7 +6,7 @@
 #pragma once
 
 #include "drivers/can/can_bus.h"
-#include "drivers/host/link_monitor.h"
+#include "drivers/host/can_device_host.h"
 #include "drivers/protocol/arm_protocol.h"
 #include "drivers/protocol/cia402.h"
 
@@ -27,31 +27,21 @@ struct ArmReading {
   bool fresh = false;
 };
 
-class ArmHost {
+class ArmHost : public CanDeviceHost {
  public:
   ArmHost(CanBus& bus, const ArmHostConfig& cfg) noexcept;
   void read_from_rt(std::int64_t now_ns) noexcept;
   // desired: set points and mode (seq and controlword are the host's).
   void write_from_rt(const arm::Command& desired, std::int64_t now_ns) noexcept;
   [[nodiscard]] const ArmReading& reading() const noexcept { return reading_; }
-  [[nodiscard]] const LinkMonitor& monitor() const noexcept { return monitor_; }
-  // SYNC counter sent by the last write (a fresh status answers exactly this one).
-  [[nodiscard]] std::uint8_t last_sync_sent() const noexcept { return sync_; }
   // fault also while the drive is not operation enabled after having been enabled.
   [[nodiscard]] LinkHealth health() const noexcept;
-  [[nodiscard]] bool commanding_safe_state() const noexcept { return safe_sent_; }
   [[nodiscard]] std::uint16_t last_controlword() const noexcept { return controlword_; }
-  [[nodiscard]] std::uint64_t send_failures() const noexcept { return send_failures_; }
 
  private:
-  CanBus& bus_;
   ArmHostConfig cfg_;
-  LinkMonitor monitor_;
   ArmReading reading_;
-  std::uint16_t seq_ = 0, controlword_ = 0;
-  std::uint8_t sync_ = 0;
-  std::uint64_t cycle_ = 0, send_failures_ = 0;
-  bool operational_ = false, safe_sent_ = false;
+  std::uint16_t controlword_ = 0;
 };
 
 }  // namespace crease::drivers

@@ -8,7 +8,7 @@
 #pragma once
 
 #include "drivers/can/can_bus.h"
-#include "drivers/host/link_monitor.h"
+#include "drivers/host/can_device_host.h"
 #include "drivers/protocol/hand_protocol.h"
 
 namespace crease::drivers {
@@ -30,33 +30,23 @@ struct HandReading {
   bool pressure_fresh = false;
 };
 
-class HandHost {
+class HandHost : public CanDeviceHost {
  public:
   HandHost(CanBus& bus, const HandHostConfig& cfg) noexcept;
   void read_from_rt(std::int64_t now_ns) noexcept;
   // desired: the controller's command (its seq is ignored; the host numbers commands).
   void write_from_rt(const hand::Command& desired, const hand::Stiffness& stiffness, std::int64_t now_ns) noexcept;
   [[nodiscard]] const HandReading& reading() const noexcept { return reading_; }
-  [[nodiscard]] const LinkMonitor& monitor() const noexcept { return monitor_; }
-  // SYNC counter sent by the last write (a fresh status answers exactly this one).
-  [[nodiscard]] std::uint8_t last_sync_sent() const noexcept { return sync_; }
   [[nodiscard]] LinkHealth health() const noexcept { return monitor_.health(); }
-  // True when the last write sent the safe command (enable = 0: hold, zero force).
-  [[nodiscard]] bool commanding_safe_state() const noexcept { return safe_sent_; }
-  [[nodiscard]] std::uint16_t last_sent_seq() const noexcept { return seq_; }
-  [[nodiscard]] std::uint64_t send_failures() const noexcept { return send_failures_; }
-  [[nodiscard]] std::uint64_t host_timeout_emcys() const noexcept { return host_timeout_emcys_; }
+  // commanding_safe_state(): the last write sent enable = 0 (hold, zero force).
 
  private:
-  CanBus& bus_;
   HandHostConfig cfg_;
-  LinkMonitor monitor_;
   HandReading reading_;
-  std::uint16_t seq_ = 0, stiff_seq_ = 0;
-  std::uint8_t sync_ = 0;
-  std::uint64_t cycle_ = 0, last_stiff_cycle_ = 0, send_failures_ = 0, host_timeout_emcys_ = 0;
+  std::uint16_t stiff_seq_ = 0;
+  std::uint64_t last_stiff_cycle_ = 0;
   float last_stiffness_[hand::kJoints] = {};
-  bool operational_ = false, safe_sent_ = false, stiffness_sent_ = false;
+  bool stiffness_sent_ = false;
 };
 
 }  // namespace crease::drivers

@@ -38,7 +38,7 @@ bool decode_heartbeat(const CanFrame& f, std::uint8_t& node, NmtState& s) noexce
   if (f.is_error() || f.is_extended() || f.is_fd() || f.len != 1) return false;
   if (f.id() <= kHeartbeatBase || f.id() > kHeartbeatBase + 0x7F) return false;
   const std::uint8_t v = f.data[0];
-  if (v != 0x00 && v != 0x04 && v != 0x05 && v != 0x7F) return false;
+  if (!is_nmt_state(v)) return false;
   node = static_cast<std::uint8_t>(f.id() - kHeartbeatBase);
   s = static_cast<NmtState>(v);
   return true;

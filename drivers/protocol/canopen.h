@@ -22,6 +22,10 @@ inline constexpr std::uint8_t kSyncCounterMax = 240;  // counter runs 1..240 (Ci
 
 enum class NmtCommand : std::uint8_t { start = 0x01, stop = 0x02, pre_operational = 0x80, reset_node = 0x81 };
 enum class NmtState : std::uint8_t { boot_up = 0x00, stopped = 0x04, operational = 0x05, pre_operational = 0x7F };
+// True when the byte is one of the NmtState values above.
+[[nodiscard]] constexpr bool is_nmt_state(std::uint8_t v) noexcept {
+  return v == 0x00 || v == 0x04 || v == 0x05 || v == 0x7F;
+}
 
 // Emergency error codes used by Crease devices (CiA 301 classes).
 enum EmcyCode : std::uint16_t {

@@ -1,6 +1,7 @@
 // Little-endian field access and the CRC-32C trailer shared by the frame codecs. RT-safe.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -45,6 +46,32 @@ inline T to_fixed(double value, double unit) noexcept {
   if (x <= lo) return std::numeric_limits<T>::min();
   if (x >= hi) return std::numeric_limits<T>::max();
   return static_cast<T>(x < 0 ? x - 0.5 : x + 0.5);
+}
+
+// A little-endian integer of type T (u8..u32 / i8..i32) at p.
+template <typename T>
+inline T get_le(const std::uint8_t* p) noexcept {
+  static_assert(sizeof(T) <= 4);
+  std::uint32_t v = 0;
+  for (std::size_t k = 0; k < sizeof(T); ++k) v |= static_cast<std::uint32_t>(p[k]) << (8 * k);
+  return static_cast<T>(v);
+}
+template <typename T>
+inline void put_le(std::uint8_t* p, T v) noexcept {
+  static_assert(sizeof(T) <= 4);
+  const auto u = static_cast<std::uint32_t>(v);
+  for (std::size_t k = 0; k < sizeof(T); ++k) p[k] = static_cast<std::uint8_t>(u >> (8 * k));
+}
+
+// n physical values as consecutive fixed-point fields of type T (unit per count, saturated).
+template <typename T, typename F>
+inline void put_fixed_array(std::uint8_t* p, const F* values, int n, double unit) noexcept {
+  for (int k = 0; k < n; ++k) put_le<T>(p + sizeof(T) * static_cast<std::size_t>(k), to_fixed<T>(values[k], unit));
+}
+template <typename T, typename F>
+inline void get_fixed_array(const std::uint8_t* p, F* values, int n, double unit) noexcept {
+  for (int k = 0; k < n; ++k)
+    values[k] = static_cast<F>(get_le<T>(p + sizeof(T) * static_cast<std::size_t>(k)) * unit);
 }
 
 }  // namespace crease::drivers::wire

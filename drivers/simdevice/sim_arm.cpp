@@ -4,50 +4,15 @@
 
 namespace crease::drivers::sim {
 
-SimArm::SimArm(CanBus& bus, const SimArmConfig& cfg) noexcept : bus_(bus), cfg_(cfg) { drive_.power_up(); }
-
-void SimArm::send(const CanFrame& f) noexcept {
-  if (silent_.load(std::memory_order_relaxed)) return;
-  if (bus_.send(f) != SendResult::ok) ++counters_.send_failures;
+SimArm::SimArm(CanBus& bus, const SimArmConfig& cfg) noexcept
+    : CanopenDevice(bus, cfg.node, cfg.watchdog_ns, cfg.heartbeat_period_ns, cfg.auto_start), cfg_(cfg) {
+  drive_.power_up();
 }
 
-void SimArm::emcy(std::uint16_t code, std::int64_t now_ns) noexcept {
-  canopen::Emcy e{cfg_.node, code, static_cast<std::uint8_t>(code ? 0x01 : 0), 0,
-                  static_cast<std::uint32_t>((now_ns - t0_ns_) / 1000)};
-  send(canopen::encode_emcy(e));
-  ++counters_.emcy_sent;
-}
-
-void SimArm::on_frame(const CanFrame& f, std::int64_t now_ns) noexcept {
-  canopen::NmtCommand nc;
-  std::uint8_t node;
-  if (canopen::decode_nmt(f, nc, node)) {
-    if (node != 0 && node != cfg_.node) return;
-    if (nc == canopen::NmtCommand::start) nmt_ = canopen::NmtState::operational;
-    if (nc == canopen::NmtCommand::stop) nmt_ = canopen::NmtState::stopped;
-    if (nc == canopen::NmtCommand::pre_operational) nmt_ = canopen::NmtState::pre_operational;
-    if (nc == canopen::NmtCommand::reset_node) booted_ = false;
-    send(canopen::encode_heartbeat(cfg_.node, nmt_));
-    return;
-  }
-  std::uint8_t counter;
-  if (canopen::decode_sync(f, counter)) {
-    ++counters_.syncs;
-    sync_counter_ = counter;
-    if (nmt_ == canopen::NmtState::operational) {
-      integrate(now_ns);
-      send_status();
-    }
-    return;
-  }
+void SimArm::on_pdo(const CanFrame& f, std::int64_t now_ns) noexcept {
   arm::Command c;
   const Decode d = arm::decode(cfg_.node, f, c);
-  if (d == Decode::bad_crc) ++counters_.bad_crc;
-  if (d != Decode::ok || nmt_ != canopen::NmtState::operational) return;
-  ++counters_.commands;
-  integrate(now_ns);
-  cmd_seq_ = c.seq;
-  last_cmd_ns_ = now_ns;
+  if (!accept_command(d, c.seq, now_ns)) return;
   controlword_ = c.controlword;
   const cia402::State before = drive_.state();
   drive_.step(c.controlword, fault_.load(std::memory_order_relaxed));
@@ -93,7 +58,7 @@ void SimArm::send_status() noexcept {
   arm::Status s;
   s.cmd_seq = cmd_seq_;
   s.statusword = cia402::statusword(drive_.state());
-  s.device_time_us = static_cast<std::uint32_t>((last_step_ns_ - t0_ns_) / 1000);
+  s.device_time_us = device_time_us();
   s.valid = 0x7F;
   s.mode = mode_;
   s.error_code = error_code_;
@@ -107,20 +72,7 @@ void SimArm::send_status() noexcept {
   ++counters_.statuses_sent;
 }
 
-void SimArm::step(std::int64_t now_ns) noexcept {
-  if (!booted_) {
-    booted_ = true;
-    t0_ns_ = last_step_ns_ = last_cmd_ns_ = last_heartbeat_ns_ = now_ns;
-    send(canopen::encode_heartbeat(cfg_.node, canopen::NmtState::boot_up));
-    nmt_ = cfg_.auto_start ? canopen::NmtState::operational : canopen::NmtState::pre_operational;
-  }
-  RxFrame rx;
-  for (int i = 0; i < 64; ++i) {
-    const RecvResult r = bus_.try_receive(rx);
-    if (r == RecvResult::empty || r == RecvResult::error) break;
-    if (r == RecvResult::frame) on_frame(rx.frame, now_ns);
-  }
-  if (bus_.state() == BusState::bus_off) bus_.restart();
+void SimArm::supervise(std::int64_t now_ns) noexcept {
   const bool fault = fault_.load(std::memory_order_relaxed);
   if (fault && !fault_reported_) {
     fault_reported_ = true;
@@ -134,7 +86,7 @@ void SimArm::step(std::int64_t now_ns) noexcept {
     emcy(canopen::kEmcyReset, now_ns);
   }
   if (drive_.state() == cia402::State::fault_reaction_active) drive_.step(controlword_, fault);
-  if (drive_.operation_enabled() && now_ns - last_cmd_ns_ > cfg_.watchdog_ns) {
+  if (drive_.operation_enabled() && command_timed_out(now_ns)) {
     integrate(now_ns);
     drive_.quick_stop();
     watchdog_tripped_ = true;
@@ -142,10 +94,9 @@ void SimArm::step(std::int64_t now_ns) noexcept {
     emcy(canopen::kEmcyHostTimeout, now_ns);
   }
   integrate(now_ns);
-  if (now_ns - last_heartbeat_ns_ >= cfg_.heartbeat_period_ns) {
-    last_heartbeat_ns_ = now_ns;
-    send(canopen::encode_heartbeat(cfg_.node, nmt_));
-  }
+}
+
+void SimArm::publish() noexcept {
   drive_pub_.store(drive_.state());
   for (int j = 0; j < arm::kJoints; ++j) pos_pub_[j].store(pos_[j], std::memory_order_relaxed);
 }

@@ -23,7 +23,7 @@
 #include "core/plugin.h"
 #include "core/port_types/hand.h"
 #include "core/port_types/tactile.h"
-#include "drivers/host/link_params.h"
+#include "drivers/host/device_port_glue.h"
 #include "drivers/host/hand_host.h"
 #include "drivers/host/tactile_host.h"
 
@@ -31,23 +31,12 @@ namespace {
 using namespace crease;
 namespace dr = crease::drivers;
 
-DeviceHealth to_health(dr::LinkHealth h) {
-  switch (h) {
-    case dr::LinkHealth::ok: return DeviceHealth::ok;
-    case dr::LinkHealth::degraded: return DeviceHealth::degraded;
-    case dr::LinkHealth::fault: return DeviceHealth::fault;
-  }
-  return DeviceHealth::fault;
-}
-
 class HandDriver final : public Plugin {
  public:
   void configure(const Params& p, PortBinder& ports) override {
     dr::HandHostConfig cfg;
-    cfg.node = static_cast<std::uint8_t>(p.get_in_range<int>("node", 1, 1, 126));
+    bus_ = dr::configure_can_device(p, cfg, 1);
     cfg.pressure_sensors = p.get<bool>("pressure_sensors", false);
-    cfg.monitor = dr::monitor_from_params(p);
-    bus_ = dr::open_bus_from_params(p);
     host_ = std::make_unique<dr::HandHost>(*bus_, cfg);
     if (p.has("tactile_device")) {
       const std::string dev = p.get<std::string>("tactile_device");
@@ -61,7 +50,7 @@ class HandDriver final : public Plugin {
       tactile_host_ = std::make_unique<dr::TactileHost>(serial_->fd(), tc);
       tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
     }
-    command_in_ = ports.latest_input<HandCommand>("hand_command");
+    command_.bind(ports.latest_input<HandCommand>("hand_command"));
     state_out_ = ports.latest_output<HandState>("hand_state", HandState{});
   }
 
@@ -69,31 +58,18 @@ class HandDriver final : public Plugin {
     const std::int64_t now = cycle.time_ns;
     host_->read_from_rt(now);
     const dr::HandReading& r = host_->reading();
-    const dr::LinkCounters& c = host_->monitor().counters();
-    state_.timestamp_ns = r.status_rx_ns;
-    state_.device_time_us = r.status.device_time_us;
-    state_.valid = r.fresh ? r.status.valid : 0;
+    dr::fill_link_state(state_, *host_);
     for (int j = 0; j < HandState::kJoints; ++j) state_.position_rad[j] = r.status.position_rad[j];
     for (int k = 0; k < HandState::kPressureSensors; ++k) state_.pressure_kpa[k] = r.pressure.pressure_kpa[k];
     state_.pressure_valid = r.pressure_fresh ? r.pressure.valid : 0;
-    state_.fresh = r.fresh ? 1 : 0;
-    state_.health = to_health(host_->health());
-    state_.acked_seq = host_->monitor().last_acked_seq();
-    state_.commands_sent = c.commands_sent;
-    state_.commands_failed = c.commands_failed;
 
-    HandCommand in;
-    if (command_in_.read(in).has_data()) {
-      command_ = in;
-      have_command_ = true;
-    }
     dr::hand::Command cmd;
     dr::hand::Stiffness stiff;
-    if (have_command_) {
-      cmd.flags = command_.enable ? dr::hand::kCmdEnable : 0;
+    if (const HandCommand* in = command_.poll()) {
+      cmd.flags = in->enable ? dr::hand::kCmdEnable : 0;
       for (int j = 0; j < HandCommand::kJoints; ++j) {
-        cmd.target_rad[j] = command_.target_rad[j];
-        stiff.stiffness_nm_per_rad[j] = command_.stiffness_nm_per_rad[j];
+        cmd.target_rad[j] = in->target_rad[j];
+        stiff.stiffness_nm_per_rad[j] = in->stiffness_nm_per_rad[j];
       }
     } else {
       for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
@@ -102,7 +78,7 @@ class HandDriver final : public Plugin {
     state_.safe_state = (host_->commanding_safe_state() || !cmd.flags) ? 1 : 0;
     state_out_.write(state_, now);
 
-    Status status = host_->health() == dr::LinkHealth::ok ? Status::ok : Status::degraded;
+    Status status = dr::to_plugin_status(host_->health());
     if (tactile_host_) {
       const bool got = tactile_host_->read_from_rt(now);
       const dr::tactile::Sample& s = tactile_host_->sample();
@@ -111,7 +87,7 @@ class HandDriver final : public Plugin {
       tactile_.sample_counter = s.sample_counter;
       tactile_.valid = s.valid;
       tactile_.fresh = got ? 1 : 0;
-      tactile_.health = to_health(tactile_host_->health(now));
+      tactile_.health = dr::to_device_health(tactile_host_->health(now));
       tactile_.age_ns = tactile_host_->samples() ? now - tactile_.timestamp_ns : 0;
       for (int f = 0; f < Tactile::kFingertips; ++f)
         for (int t = 0; t < Tactile::kTaxels; ++t) tactile_.pressure_kpa[f][t] = s.pressure_kpa[f][t];
@@ -126,11 +102,9 @@ class HandDriver final : public Plugin {
   std::unique_ptr<dr::HandHost> host_;
   std::unique_ptr<dr::SerialPort> serial_;
   std::unique_ptr<dr::TactileHost> tactile_host_;
-  LatestInput<HandCommand> command_in_;
+  dr::HeldCommand<HandCommand> command_;
   LatestOutput<HandState> state_out_;
   LatestOutput<Tactile> tactile_out_;
-  HandCommand command_;
-  bool have_command_ = false;
   HandState state_;
   Tactile tactile_;
 };

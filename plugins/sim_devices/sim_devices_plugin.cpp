@@ -57,11 +57,10 @@ class SimDevices final : public Plugin {
     hands_.push_back(std::make_unique<dr::sim::SimHand>(*b1, left));
     arms_.push_back(std::make_unique<dr::sim::SimArm>(*b2, arm_r));
     arms_.push_back(std::make_unique<dr::sim::SimArm>(*b3, arm_l));
-    for (std::size_t i = 0; i < 2; ++i) {
-      auto* h = hands_[i].get();
-      threads_.push_back(std::make_unique<dr::sim::DeviceThread>(buses_[i]->fd(), [h](std::int64_t t) { h->step(t); }));
-      auto* a = arms_[i].get();
-      threads_.push_back(std::make_unique<dr::sim::DeviceThread>(buses_[2 + i]->fd(), [a](std::int64_t t) { a->step(t); }));
+    dr::sim::CanopenDevice* devices[] = {hands_[0].get(), hands_[1].get(), arms_[0].get(), arms_[1].get()};
+    for (std::size_t i = 0; i < 4; ++i) {
+      dr::sim::CanopenDevice* d = devices[i];
+      threads_.push_back(std::make_unique<dr::sim::DeviceThread>(buses_[i]->fd(), [d](std::int64_t t) { d->step(t); }));
     }
   }
 

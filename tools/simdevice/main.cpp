@@ -102,6 +102,11 @@ int serve(const Args& a, int fd, const std::function<void(std::int64_t)>& step,
   return 0;
 }
 
+// A simulated CAN device (hand or arm) on its mock bus node.
+int serve_can_device(const Args& a, const MockCanBus& bus, sim::CanopenDevice& dev) {
+  return serve(a, bus.fd(), [&](std::int64_t t) { dev.step(t); }, [&](bool s) { dev.set_silent(s); });
+}
+
 MockCanBusConfig bus_config(const Args& a, std::uint32_t node) {
   if (!a.has("bus")) throw std::invalid_argument("option --bus is required");
   return {a.str("bus"), node, static_cast<std::uint32_t>(a.num("bitrate", 1'000'000)),
@@ -153,15 +158,15 @@ int run(const Args& a) {
     cfg.node = node;
     cfg.pressure_sensors = a.has("pressure");
     sim::SimHand hand(bus, cfg);
-    return serve(a, bus.fd(), [&](std::int64_t t) { hand.step(t); }, [&](bool s) { hand.set_silent(s); });
+    return serve_can_device(a, bus, hand);
   }
   if (a.mode == "arm") {
     const std::uint8_t node = node_of(a);
     MockCanBus bus(bus_config(a, node));
     sim::SimArmConfig cfg;
     cfg.node = node;
-    sim::SimArm dev(bus, cfg);
-    return serve(a, bus.fd(), [&](std::int64_t t) { dev.step(t); }, [&](bool s) { dev.set_silent(s); });
+    sim::SimArm arm(bus, cfg);
+    return serve_can_device(a, bus, arm);
   }
   if (a.mode == "tactile") {
     PtyPair pty;

@@ -47,6 +47,9 @@ TEST_CASE("the host enables the drive, tracks set points, resets a fault once it
   REQUIRE(run_until_enabled(host, cmd, tick, 1000));
   run(host, cmd, tick, 300);
   CHECK(std::abs(host.reading().status.position_rad[6] - 0.7f) < 0.01f);
+  // The drive echoes the seq of the commands it applied (acknowledgements reach the monitor).
+  CHECK(host.monitor().counters().commands_acked > 0);
+  CHECK(host.monitor().last_acked_seq() != 0);
 
   arm_dev.set_fault(true);
   run(host, cmd, tick, 5);

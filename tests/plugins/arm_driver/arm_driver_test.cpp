@@ -6,45 +6,18 @@
 #include <string>
 #include <thread>
 
-#include "core/plugin_host.h"
 #include "core/port_types/arm.h"
 #include "drivers/can/mock_can_broker.h"
 #include "drivers/can/mock_can_bus.h"
 #include "drivers/simdevice/device_thread.h"
 #include "drivers/simdevice/sim_arm.h"
 #include "rt/alloc_guard.h"
+#include "tests/drivers/hil/driver_plugin_rig.h"
 
 using namespace crease;
 namespace dr = crease::drivers;
 
-namespace {
-InstanceSpec spec(const std::string& yaml) {
-  InstanceSpec s;
-  s.name = "arm_r";
-  s.library = "arm_driver";
-  s.loop = "control";
-  s.params = Params(YAML::Load(yaml), "test.yaml", "arm_r.params");
-  return s;
-}
-ArmState state_of(PluginHost& host) {
-  ArmState v{};
-  const auto* ch = host.ports().find_latest("arm_r.arm_state");
-  if (ch == nullptr) ch = host.ports().find_latest("arm_state");
-  REQUIRE(ch != nullptr);
-  ch->read(&v, 0);
-  return v;
-}
-// Polls the state until pred holds (at most 3 s): instant checks flake on a loaded machine.
-template <class P>
-ArmState wait_for(PluginHost& host, P pred) {
-  ArmState s = state_of(host);
-  for (int i = 0; i < 3000 && !pred(s); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    s = state_of(host);
-  }
-  return s;
-}
-}  // namespace
+using Rig = test::DriverPluginRig<ArmState>;
 
 TEST_CASE("arm_driver: enables the drive, fresh state, no allocation, quick stop on silence, recovery") {
   const std::string bus = "plug-arm-" + std::to_string(::getpid());
@@ -53,11 +26,10 @@ TEST_CASE("arm_driver: enables the drive, fresh state, no allocation, quick stop
   dr::sim::SimArm arm_dev(dev_bus, {.node = 10});
   dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { arm_dev.step(t); });
 
-  PluginHost host({CREASE_PLUGIN_DIR});
-  host.add_loop({"control", 1000.0, 0, -1});
-  host.add_instance(spec("{bus: " + bus + ", node: 10}"));
-  host.start();
-  ArmState s = wait_for(host, [](const ArmState& v) { return v.health == DeviceHealth::ok && v.commands_sent > 200; });
+  Rig rig("arm_r", "arm_driver", "arm_state");
+  rig.add("{bus: " + bus + ", node: 10}");
+  rig.host.start();
+  ArmState s = rig.wait_for([](const ArmState& v) { return v.health == DeviceHealth::ok && v.commands_sent > 200; });
   CHECK(s.health == DeviceHealth::ok);
   CHECK(s.commands_sent > 200);
   CHECK(s.commands_failed * 4 < s.commands_sent);
@@ -68,26 +40,17 @@ TEST_CASE("arm_driver: enables the drive, fresh state, no allocation, quick stop
   CHECK(rt::rt_allocation_count() == allocs);  // the loop thread is RT-marked
 
   arm_dev.set_silent(true);
-  s = wait_for(host, [](const ArmState& v) { return v.health == DeviceHealth::fault; });
+  s = rig.wait_for([](const ArmState& v) { return v.health == DeviceHealth::fault; });
   CHECK(s.health == DeviceHealth::fault);
   CHECK(s.fresh == 0);
   CHECK(s.safe_state == 1);
   arm_dev.set_silent(false);
-  s = wait_for(host, [](const ArmState& v) { return v.health == DeviceHealth::ok; });
+  s = rig.wait_for([](const ArmState& v) { return v.health == DeviceHealth::ok; });
   CHECK(s.health == DeviceHealth::ok);  // re-enabled by the driver after the drive's quick stop
   CHECK(s.fresh == 1);
-  host.stop();
+  rig.host.stop();
 }
 
 TEST_CASE("arm_driver: a bus nobody serves is a configuration error naming the key") {
-  PluginHost host({CREASE_PLUGIN_DIR});
-  host.add_loop({"control", 1000.0, 0, -1});
-  try {
-    host.add_instance(spec("{bus: no-such-bus-crease, node: 1}"));
-    FAIL("add_instance must throw");
-  } catch (const std::exception& e) {
-    const std::string what = e.what();
-    CHECK(what.find("bus") != std::string::npos);
-    CHECK(what.find("no-such-bus-crease") != std::string::npos);
-  }
+  Rig("arm_r", "arm_driver", "arm_state").check_unserved_bus_is_config_error();
 }

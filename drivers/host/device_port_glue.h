@@ -1,0 +1,78 @@
+// The glue between a CAN device host (HandHost, ArmHost) and the ports of its driver plugin,
+// shared by plugins/hand_driver and plugins/arm_driver. Header-only; everything called from
+// update() is RT-safe (no allocation, no locks, no blocking).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "core/params.h"
+#include "core/plugin.h"
+#include "core/port_types/hand.h"
+#include "drivers/can/can_bus.h"
+#include "drivers/host/link_monitor.h"
+#include "drivers/host/link_params.h"
+
+namespace crease::drivers {
+
+[[nodiscard]] inline DeviceHealth to_device_health(LinkHealth h) noexcept {
+  switch (h) {
+    case LinkHealth::ok: return DeviceHealth::ok;
+    case LinkHealth::degraded: return DeviceHealth::degraded;
+    case LinkHealth::fault: return DeviceHealth::fault;
+  }
+  return DeviceHealth::fault;
+}
+
+// A plugin stays scheduled through link faults (it recovers by itself): degraded, never error.
+[[nodiscard]] inline Status to_plugin_status(LinkHealth h) noexcept {
+  return h == LinkHealth::ok ? Status::ok : Status::degraded;
+}
+
+// Configure time: the node (`node`, 1..126), the link monitor and the bus the parameters name
+// (link_params.h) into a HandHostConfig / ArmHostConfig. Throws ConfigError on a bad value.
+template <typename HostConfig>
+[[nodiscard]] std::unique_ptr<CanBus> configure_can_device(const Params& p, HostConfig& cfg, int default_node) {
+  cfg.node = static_cast<std::uint8_t>(p.get_in_range<int>("node", default_node, 1, 126));
+  cfg.monitor = monitor_from_params(p);
+  return open_bus_from_params(p);
+}
+
+// The link fields every device state port carries (HandState, ArmState) from the host's
+// latest reading: reception and device time, valid bits (0 unless fresh), health, acks.
+template <typename State, typename Host>
+void fill_link_state(State& s, const Host& host) noexcept {
+  const auto& r = host.reading();
+  const LinkCounters& c = host.monitor().counters();
+  s.timestamp_ns = r.status_rx_ns;
+  s.device_time_us = r.status.device_time_us;
+  s.valid = r.fresh ? r.status.valid : 0;
+  s.fresh = r.fresh ? 1 : 0;
+  s.health = to_device_health(host.health());
+  s.acked_seq = host.monitor().last_acked_seq();
+  s.commands_sent = c.commands_sent;
+  s.commands_failed = c.commands_failed;
+}
+
+// The newest command of a latest-value input, kept across cycles (commands are never queued).
+template <typename Command>
+class HeldCommand {
+ public:
+  void bind(LatestInput<Command> in) noexcept { in_ = in; }
+  // Reads the input; nullptr until a first command has arrived (the driver then holds).
+  const Command* poll() noexcept {
+    Command in;
+    if (in_.read(in).has_data()) {
+      value_ = in;
+      have_ = true;
+    }
+    return have_ ? &value_ : nullptr;
+  }
+
+ private:
+  LatestInput<Command> in_;
+  Command value_;
+  bool have_ = false;
+};
+
+}  // namespace crease::drivers

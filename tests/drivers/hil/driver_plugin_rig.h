@@ -1,0 +1,75 @@
+// Shared fixture of the driver plugin tests (tests/plugins/hand_driver, tests/plugins/arm_driver):
+// one driver plugin instance in a 1 kHz "control" loop of a PluginHost, its state port read
+// back, and the configuration-error case every CAN driver plugin shares.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <exception>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "core/plugin_host.h"
+
+namespace crease::test {
+
+template <typename State>
+class DriverPluginRig {
+ public:
+  // instance: the instance name; library: the plugin; port: its state output port.
+  DriverPluginRig(std::string instance, std::string library, std::string port)
+      : host({CREASE_PLUGIN_DIR}), instance_(std::move(instance)), library_(std::move(library)), port_(std::move(port)) {
+    host.add_loop({"control", 1000.0, 0, -1});
+  }
+
+  [[nodiscard]] InstanceSpec spec(const std::string& yaml) const {
+    InstanceSpec s;
+    s.name = instance_;
+    s.library = library_;
+    s.loop = "control";
+    s.params = Params(YAML::Load(yaml), "test.yaml", instance_ + ".params");
+    return s;
+  }
+  void add(const std::string& yaml) { host.add_instance(spec(yaml)); }
+
+  // The latest value of the state port.
+  [[nodiscard]] State state() {
+    State v{};
+    const auto* ch = host.ports().find_latest(instance_ + "." + port_);
+    if (ch == nullptr) ch = host.ports().find_latest(port_);
+    REQUIRE(ch != nullptr);
+    ch->read(&v, 0);
+    return v;
+  }
+  // Polls the state until pred holds (at most 3 s): instant checks flake on a loaded machine.
+  template <class P>
+  State wait_for(P pred) {
+    State s = state();
+    for (int i = 0; i < 3000 && !pred(s); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      s = state();
+    }
+    return s;
+  }
+
+  // A bus nobody serves is a configuration error naming the key and the bus.
+  void check_unserved_bus_is_config_error() {
+    try {
+      add("{bus: no-such-bus-crease, node: 1}");
+      FAIL("add_instance must throw");
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      CHECK(what.find("bus") != std::string::npos);
+      CHECK(what.find("no-such-bus-crease") != std::string::npos);
+    }
+  }
+
+  PluginHost host;
+
+ private:
+  std::string instance_, library_, port_;
+};
+
+}  // namespace crease::test
