@@ -1,5 +1,6 @@
 #include "camera_source.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <ctime>
@@ -84,49 +85,121 @@ bool ReplaySource::grab(Frame& frame) {
   return true;
 }
 
-V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices)
-    : cameras_(std::move(cameras)) {
+namespace {
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
+}  // namespace
+
+V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
+                       ReconnectPolicy policy)
+    : cameras_(std::move(cameras)), policy_(policy) {
   if (devices.size() != cameras_.size())
     throw std::invalid_argument("camera_v4l2: " + std::to_string(devices.size()) + " devices for " +
                                 std::to_string(cameras_.size()) + " calibrations");
+  if (devices.size() > kMaxCameras)
+    throw std::invalid_argument("camera_v4l2: " + std::to_string(devices.size()) +
+                                " devices, at most " + std::to_string(kMaxCameras));
+  if (!(policy_.initial_s > 0.0) || !(policy_.max_s >= policy_.initial_s))
+    throw std::invalid_argument("camera_v4l2: reconnect times must satisfy 0 < initial (" +
+                                std::to_string(policy_.initial_s) + " s) <= max (" +
+                                std::to_string(policy_.max_s) + " s)");
+  reconnects_ = std::make_unique<std::atomic<std::uint64_t>[]>(devices.size());
+  devices_.resize(devices.size());
+  const std::int64_t now = monotonic_ns();
+  std::uint32_t dark = 0;
   for (std::size_t k = 0; k < devices.size(); ++k) {
-    // Device nodes through V4L2; anything else (a video file, an image sequence pattern such as
-    // dir/%06d.png) through whichever backend opens it.
-    const bool device = devices[k].rfind("/dev/", 0) == 0;
-    cv::VideoCapture cap;
-    try {
-      cap.open(devices[k], device ? cv::CAP_V4L2 : cv::CAP_ANY);
-    } catch (const cv::Exception&) {
-      cap.release();  // unopenable: this camera delivers nothing, the others go on
-    }
-    if (cap.isOpened() && device) {
-      cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
-      cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
-    }
-    if (!cap.isOpened()) failed_.push_back(devices[k]);
-    caps_.push_back(std::move(cap));
+    devices_[k].path = devices[k];
+    if (try_open(k)) continue;
+    failed_.push_back(devices[k]);
+    dark |= 1u << k;
+    went_dark(k, now);
   }
+  dark_.store(dark, std::memory_order_release);
+}
+
+bool V4l2Source::try_open(std::size_t k) {
+  Device& d = devices_[k];
+  // Device nodes through V4L2; an image sequence pattern (dir/%06d.png) through OpenCV's image
+  // reader, which reads each file when grabbed (a missing file: the camera stopped); anything
+  // else (a video file) through whichever backend opens it.
+  const bool node = d.path.rfind("/dev/", 0) == 0;
+  const bool sequence = d.path.find('%') != std::string::npos;
+  try {
+    d.cap.open(d.path, node ? cv::CAP_V4L2 : sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
+    if (d.cap.isOpened() && node) {
+      d.cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
+      d.cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
+    }
+  } catch (const cv::Exception&) {
+    d.cap.release();  // unopenable now: retried later
+  }
+  d.open = d.cap.isOpened();
+  return d.open;
+}
+
+void V4l2Source::went_dark(std::size_t k, std::int64_t now_ns) {
+  Device& d = devices_[k];
+  d.cap.release();
+  d.open = false;
+  d.backoff_s = policy_.initial_s;
+  d.retry_at_ns = now_ns + seconds_to_ns(d.backoff_s);
 }
 
 bool V4l2Source::grab(Frame& frame) {
   frame.index = next_++;
-  frame.images.resize(caps_.size());
+  frame.images.resize(devices_.size());
+  const std::int64_t before = monotonic_ns();
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    Device& d = devices_[k];
+    if (d.open || before < d.retry_at_ns) continue;
+    if (try_open(k)) {
+      reconnects_[k].fetch_add(1, std::memory_order_acq_rel);
+      total_reconnects_.fetch_add(1, std::memory_order_acq_rel);
+    } else {
+      d.retry_at_ns = before + seconds_to_ns(d.backoff_s);
+      d.backoff_s = std::min(2.0 * d.backoff_s, policy_.max_s);
+    }
+  }
   // grab() all first so the exposures are as close in time as the devices allow.
-  std::vector<bool> ok(caps_.size());
-  for (std::size_t k = 0; k < caps_.size(); ++k) ok[k] = caps_[k].isOpened() && caps_[k].grab();
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  frame.timestamp_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+  std::vector<bool> ok(devices_.size());
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    try {
+      ok[k] = devices_[k].open && devices_[k].cap.grab();
+    } catch (const cv::Exception&) {
+      ok[k] = false;
+    }
+  }
+  frame.timestamp_ns = monotonic_ns();
   cv::Mat bgr;
-  for (std::size_t k = 0; k < caps_.size(); ++k) {
+  std::uint32_t dark = 0;
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    Device& d = devices_[k];
     frame.images[k] = cv::Mat();
-    if (!ok[k] || !caps_[k].retrieve(bgr) || bgr.empty()) continue;  // disconnected: others go on
+    bool read = ok[k];
+    try {
+      read = read && d.cap.retrieve(bgr) && !bgr.empty();
+    } catch (const cv::Exception&) {
+      read = false;
+    }
+    if (!read) {
+      if (d.open) went_dark(k, frame.timestamp_ns);  // stopped or disconnected: reopen later
+      dark |= 1u << k;
+      continue;
+    }
     if (bgr.channels() == 3) cv::cvtColor(bgr, frame.images[k], cv::COLOR_BGR2GRAY);
     else if (bgr.channels() == 1) frame.images[k] = bgr.clone();
     const Camera& c = cameras_[k];
-    if (frame.images[k].cols != c.width || frame.images[k].rows != c.height) frame.images[k] = cv::Mat();
+    if (frame.images[k].cols != c.width || frame.images[k].rows != c.height) {
+      frame.images[k] = cv::Mat();  // delivers, but not this calibration's image
+      dark |= 1u << k;
+    }
   }
-  return true;  // live cameras do not end; one that stopped delivers empty images
+  dark_.store(dark, std::memory_order_release);
+  return true;  // live cameras do not end; a dark one delivers empty images until it is back
 }
 
 Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras) : dir_(dir), ncam_(cameras.size()) {

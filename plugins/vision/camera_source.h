@@ -7,6 +7,7 @@
 // Not RT code (file and device I/O, OpenCV allocation): run it on a vision worker thread.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -73,23 +74,63 @@ class ReplaySource final : public CameraSource {
   std::size_t next_ = 0;
 };
 
+// How a live camera that did not open, or stopped delivering, is brought back: the capture
+// worker (inside grab()) retries opening it `initial_s` after the failure, doubling the wait
+// after each failed attempt up to `max_s` (seconds, CLOCK_MONOTONIC).
+struct ReconnectPolicy {
+  double initial_s = 0.5;
+  double max_s = 5.0;
+};
+
 // Live cameras through cv::VideoCapture; device k is cameras[k]. /dev/... opens with the V4L2
-// backend; any other string (a video file, an image sequence pattern) with whichever backend
-// OpenCV finds. A device that does not open, stops, or delivers another image size gives empty
-// images (the others go on); grab() never ends.
+// backend; an image sequence pattern (dir/%06d.png) with OpenCV's image reader (a file missing
+// when its turn comes is a camera that stopped); any other string (a video file) with whichever
+// backend OpenCV finds. A device that does not open or stops (grab/retrieve fails) is released and
+// reopened per the ReconnectPolicy; while it is dark, and when it delivers another image size,
+// its image is empty (the others go on). grab() never ends. A reopen attempt runs inside grab()
+// (a missing device fails at once; a device that came back delays that one frame by its open).
 class V4l2Source final : public CameraSource {
  public:
-  // Throws std::invalid_argument when devices and calibrations differ in number.
-  V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices);
+  static constexpr std::size_t kMaxCameras = 32;  // one bit each in dark_mask()
+  // Throws std::invalid_argument when devices and calibrations differ in number, there are more
+  // than kMaxCameras, or the policy is not 0 < initial_s <= max_s.
+  V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
+             ReconnectPolicy policy = {});
   [[nodiscard]] const std::vector<Camera>& cameras() const override { return cameras_; }
   bool grab(Frame& frame) override;
-  // The devices that did not open.
+  // The devices that did not open at construction.
   [[nodiscard]] const std::vector<std::string>& failed_devices() const { return failed_; }
+  // Any thread (atomics). Bit k: camera k delivered nothing in the last grab (dark since
+  // construction until the first grab when it did not open).
+  [[nodiscard]] std::uint32_t dark_mask() const noexcept {
+    return dark_.load(std::memory_order_acquire);
+  }
+  // Any thread. Times camera k (or all cameras) opened again after failing to open or stopping.
+  [[nodiscard]] std::uint64_t reconnects(std::size_t k) const noexcept {
+    return k < cameras_.size() ? reconnects_[k].load(std::memory_order_acquire) : 0;
+  }
+  [[nodiscard]] std::uint64_t reconnects() const noexcept {
+    return total_reconnects_.load(std::memory_order_acquire);
+  }
 
  private:
+  struct Device {
+    std::string path;
+    cv::VideoCapture cap;
+    bool open = false;
+    std::int64_t retry_at_ns = 0;  // next open attempt while closed
+    double backoff_s = 0;          // wait after the next failed attempt
+  };
+  bool try_open(std::size_t k);                   // true when it opened
+  void went_dark(std::size_t k, std::int64_t now_ns);  // release, retry after initial_s
+
   std::vector<Camera> cameras_;
-  std::vector<cv::VideoCapture> caps_;
+  ReconnectPolicy policy_;
+  std::vector<Device> devices_;
   std::vector<std::string> failed_;
+  std::unique_ptr<std::atomic<std::uint64_t>[]> reconnects_;
+  std::atomic<std::uint64_t> total_reconnects_{0};
+  std::atomic<std::uint32_t> dark_{0};
   std::uint64_t next_ = 0;
 };
 

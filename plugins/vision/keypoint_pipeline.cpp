@@ -1,6 +1,8 @@
 #include "keypoint_pipeline.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace crease::vision {
 
@@ -73,8 +75,12 @@ void build_keypoints(const std::vector<Camera>& cams, const MarkerLayout& layout
 }
 
 KeypointPipeline::KeypointPipeline(std::vector<Camera> cams, MarkerLayout layout, DetectorConfig det,
-                                   TriangulationConfig tri)
+                                   TriangulationConfig tri, int camera_threads)
     : cams_(std::move(cams)), layout_(std::move(layout)), tri_(tri) {
+  if (camera_threads < 0)
+    throw std::invalid_argument("camera_threads: expected 0 (OpenCV's pool) or >= 1, not " +
+                                std::to_string(camera_threads));
+  if (camera_threads >= 1) team_ = std::make_unique<TaskTeam>(camera_threads - 1);
   if (det.max_id < 0) det.max_id = layout_.max_id();
   det.dictionary = layout_.dictionary;
   for (std::size_t k = 0; k < cams_.size(); ++k) detectors_.emplace_back(det);
@@ -87,15 +93,21 @@ void KeypointPipeline::reset() {
 
 void KeypointPipeline::process(const std::vector<cv::Mat>& images, std::int64_t t_ns, crease::Keypoints& out) {
   const int n = static_cast<int>(cams_.size());
-  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& r) {
-    for (int k = r.start; k < r.end; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      if (ku < images.size() && !images[ku].empty())
-        detectors_[ku].detect(images[ku], dets_[ku]);
-      else
-        dets_[ku].clear();
-    }
-  }, n);
+  // Camera k touches only detectors_[k] and dets_[k].
+  const auto detect = [&](int k) {
+    const auto ku = static_cast<std::size_t>(k);
+    if (ku < images.size() && !images[ku].empty())
+      detectors_[ku].detect(images[ku], dets_[ku]);
+    else
+      dets_[ku].clear();
+  };
+  if (team_) {
+    team_->run(n, detect);
+  } else {
+    cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& r) {
+      for (int k = r.start; k < r.end; ++k) detect(k);
+    }, n);
+  }
   out.timestamp_ns = t_ns;
   out.frame = frame_++;
   out.cameras_ok = 0;

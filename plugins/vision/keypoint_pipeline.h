@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -11,6 +12,7 @@
 #include "core/port_types/keypoints.h"
 #include "marker_detector.h"
 #include "marker_layout.h"
+#include "task_team.h"
 #include "triangulation.h"
 
 namespace crease::vision {
@@ -27,8 +29,11 @@ void build_keypoints(const std::vector<Camera>& cams, const MarkerLayout& layout
 
 class KeypointPipeline {
  public:
+  // camera_threads: 0 detects the cameras in parallel through cv::parallel_for_ (OpenCV's
+  // pool); N >= 1 on N threads of our own, the caller of process() and N-1 helpers (TaskTeam;
+  // 1: one camera after the other on the caller). Throws std::invalid_argument when negative.
   KeypointPipeline(std::vector<Camera> cams, MarkerLayout layout, DetectorConfig det,
-                   TriangulationConfig tri);
+                   TriangulationConfig tri, int camera_threads = 0);
 
   // images[k] from camera k (CV_8UC1, or empty when camera k delivered nothing this frame).
   void process(const std::vector<cv::Mat>& images, std::int64_t timestamp_ns, crease::Keypoints& out);
@@ -43,6 +48,7 @@ class KeypointPipeline {
   TriangulationConfig tri_;
   std::vector<MarkerDetector> detectors_;
   std::vector<std::vector<MarkerDetection>> dets_;
+  std::unique_ptr<TaskTeam> team_;  // camera_threads >= 1
   std::uint64_t frame_ = 0;
 };
 

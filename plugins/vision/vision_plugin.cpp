@@ -10,6 +10,9 @@
 //   cameras: DIR of cam0.yaml.. (the calibrations of the channel's cameras, in order; for a
 //            replay, the recording's folder)        channel: NAME (default "cameras")
 //   layout: layout.yaml     decimate, full_search_interval; max_reproj_px, refine; stale_cycles
+//   camera_threads: 0 (default: cameras detected in parallel by OpenCV's pool) or N >= 1 (one
+//            task per camera on the worker and N-1 helper threads of ours, task_team.h; OpenCV's
+//            loops inside each detection still use its pool unless cv::setNumThreads(1))
 // Inputs: frames (crease::CameraFrames). Outputs: keypoints (crease::Keypoints).
 // Status: degraded when a camera delivered nothing, no new key-points came for
 // `stale_cycles` cycles, or the source ended; fault if the worker failed.
@@ -47,6 +50,7 @@ class VisionPlugin final : public crease::Plugin {
     tri.max_reproj_px = p.get_in_range<double>("max_reproj_px", 2.0, 0.1, 50.0);
     tri.refine = p.get<bool>("refine", true);
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
+    const int camera_threads = p.get_in_range<int>("camera_threads", 0, 0, 64);
     const std::string name = p.get<std::string>("channel", "cameras");
     if (name.empty() || name.size() >= crease::CameraFrames::kChannelNameCapacity)
       p.fail("channel", "expected a name of 1.." +
@@ -59,7 +63,8 @@ class VisionPlugin final : public crease::Plugin {
     buf_ = std::make_unique<crease::Keypoints>();
     frames_in_ = ports.latest_input<crease::CameraFrames>("frames");
     out_ = ports.latest_output<crease::Keypoints>("keypoints", crease::Keypoints{});
-    worker_ = std::make_unique<VisionWorker>(std::move(channel), std::move(cams), layout, det, tri);
+    worker_ = std::make_unique<VisionWorker>(std::move(channel), std::move(cams), layout, det, tri,
+                                             camera_threads);
   }
 
   crease::Status update(const crease::Cycle& cycle) override {

@@ -8,9 +8,10 @@ namespace crease::vision {
 
 VisionWorker::VisionWorker(std::shared_ptr<crease::frames::FrameChannel> channel,
                            std::vector<Camera> cameras, const MarkerLayout& layout,
-                           const DetectorConfig& det, const TriangulationConfig& tri)
+                           const DetectorConfig& det, const TriangulationConfig& tri,
+                           int camera_threads)
     : channel_(std::move(channel)),
-      pipeline_(cameras, layout, det, tri),
+      pipeline_(cameras, layout, det, tri, camera_threads),
       result_(std::make_unique<crease::Keypoints>()),
       images_(cameras.size()) {
   if (channel_->cameras() != channel_specs(cameras))

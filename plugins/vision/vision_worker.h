@@ -24,10 +24,12 @@ class VisionWorker {
  public:
   // `cameras` are the calibrations of the channel's cameras, in its order (names and sizes must
   // match: std::invalid_argument otherwise). The reader end is claimed now if free, else on the
-  // worker thread as soon as the previous reader releases it (a hot swap).
+  // worker thread as soon as the previous reader releases it (a hot swap). camera_threads:
+  // KeypointPipeline's (0: cameras through cv::parallel_for_; N >= 1: on this worker and N-1
+  // helper threads of ours).
   VisionWorker(std::shared_ptr<crease::frames::FrameChannel> channel, std::vector<Camera> cameras,
                const MarkerLayout& layout, const DetectorConfig& det,
-               const TriangulationConfig& tri);
+               const TriangulationConfig& tri, int camera_threads = 0);
   ~VisionWorker();
   VisionWorker(const VisionWorker&) = delete;
   VisionWorker& operator=(const VisionWorker&) = delete;

@@ -1,9 +1,13 @@
 #include "camera_source.h"
 
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <doctest/doctest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "keypoint_pipeline.h"
 #include "vision_fixture.h"
@@ -90,4 +94,104 @@ TEST_CASE("a camera whose files stop leaves the others running; bad recordings n
   std::ofstream(dir + "/timestamps.csv") << "frame,timestamp_ns\n0;12\n";
   CHECK_THROWS_WITH_AS(ReplaySource{dir}, doctest::Contains("timestamps.csv: line 2"), std::runtime_error);
   CHECK_THROWS_WITH_AS(ReplaySource{tmp_dir("nothing")}, doctest::Contains("cam0.yaml"), std::runtime_error);
+}
+
+namespace {
+// An image sequence camera_v4l2 can open: DIR/NNNNNN.png, `frames` uniform grey images.
+void write_sequence(const std::filesystem::path& dir, int frames, int grey) {
+  std::filesystem::create_directories(dir);
+  const cv::Mat im(48, 64, CV_8UC1, cv::Scalar(grey));
+  char name[32];
+  for (int i = 0; i < frames; ++i) {
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    REQUIRE(cv::imwrite((dir / name).string(), im));
+  }
+}
+
+std::vector<Camera> tiny_rig() {
+  return {look_at_camera("a", 64, 48, 60, {0, -60, 450}, {0, 0, 0}),
+          look_at_camera("b", 64, 48, 60, {250, 250, 350}, {0, 0, 0})};
+}
+
+// Grabs (5 ms apart, at most ~3 s) until camera k's image is empty (dark) or not.
+bool grab_until(V4l2Source& src, Frame& f, std::size_t k, bool dark) {
+  for (int i = 0; i < 600; ++i) {
+    REQUIRE(src.grab(f));
+    if (f.images[k].empty() == dark) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+constexpr ReconnectPolicy kFastRetry{.initial_s = 0.02, .max_s = 0.08};
+}  // namespace
+
+TEST_CASE("camera_v4l2 source: a device missing at start is opened once it appears") {
+  const std::filesystem::path dir = tmp_dir("late");
+  write_sequence(dir / "a", 60, 90);
+  const std::string late = (dir / "b" / "%06d.png").string();
+  V4l2Source src(tiny_rig(), {(dir / "a" / "%06d.png").string(), late}, kFastRetry);
+  CHECK(src.failed_devices() == std::vector<std::string>{late});
+  CHECK(src.dark_mask() == 0x2u);
+  Frame f;
+  for (int i = 0; i < 5; ++i) {  // several retries pass: still nothing there
+    REQUIRE(src.grab(f));
+    CHECK_FALSE(f.images[0].empty());
+    CHECK(f.images[1].empty());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  CHECK(src.reconnects(1) == 0);
+  write_sequence(dir / "b", 60, 200);
+  REQUIRE(grab_until(src, f, 1, false));
+  CHECK(f.images[1].at<std::uint8_t>(10, 10) == 200);
+  CHECK_FALSE(f.images[0].empty());
+  CHECK(src.dark_mask() == 0u);
+  CHECK(src.reconnects(1) == 1);
+  CHECK(src.reconnects(0) == 0);
+  CHECK(src.reconnects() == 1);
+}
+
+TEST_CASE("camera_v4l2 source: a device that stops is dark, retried, and back when it returns") {
+  const std::filesystem::path dir = tmp_dir("stop");
+  write_sequence(dir / "a", 60, 90);
+  write_sequence(dir / "b", 60, 200);
+  V4l2Source src(tiny_rig(), {(dir / "a" / "%06d.png").string(), (dir / "b" / "%06d.png").string()},
+                 kFastRetry);
+  CHECK(src.failed_devices().empty());
+  Frame f;
+  REQUIRE(src.grab(f));
+  CHECK_FALSE(f.images[1].empty());
+  CHECK(src.dark_mask() == 0u);
+  std::filesystem::rename(dir / "b", dir / "b.unplugged");  // the device goes away
+  REQUIRE(grab_until(src, f, 1, true));
+  CHECK(src.dark_mask() == 0x2u);
+  for (int i = 0; i < 5; ++i) {  // reopen attempts fail while it is away
+    REQUIRE(src.grab(f));
+    CHECK(f.images[1].empty());
+    CHECK_FALSE(f.images[0].empty());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  CHECK(src.reconnects(1) == 0);
+  std::filesystem::rename(dir / "b.unplugged", dir / "b");  // plugged in again
+  REQUIRE(grab_until(src, f, 1, false));
+  CHECK(f.images[1].at<std::uint8_t>(10, 10) == 200);
+  CHECK(src.dark_mask() == 0u);
+  CHECK(src.reconnects(1) == 1);
+  CHECK(src.reconnects(0) == 0);
+}
+
+TEST_CASE("camera_v4l2 source: bad reconnect times and device counts are refused") {
+  const std::vector<std::string> two{"/dev/video97", "/dev/video98"};
+  CHECK_THROWS_WITH_AS(V4l2Source(tiny_rig(), two, {.initial_s = 0.0, .max_s = 1.0}),
+                       doctest::Contains("reconnect"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(V4l2Source(tiny_rig(), two, {.initial_s = 2.0, .max_s = 1.0}),
+                       doctest::Contains("reconnect"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(V4l2Source(tiny_rig(), {"/dev/video97"}), doctest::Contains("1 devices for 2"),
+                       std::invalid_argument);
+  V4l2Source none(tiny_rig(), two, kFastRetry);  // nothing opens: dark, never ends
+  Frame f;
+  CHECK(none.grab(f));
+  CHECK(none.dark_mask() == 0x3u);
+  CHECK(f.images.size() == 2);
+  CHECK(f.images[0].empty());
 }

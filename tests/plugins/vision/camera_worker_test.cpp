@@ -1,6 +1,8 @@
 // CameraWorker: one requested frame -> one published set in the frame channel (valid flags per
 // camera, pixels, recording), end of source, no allocation on the RT side, and the hand-over of
-// the writer end from an old worker to a new one (a hot swap).
+// the writer end from an old worker to a new one (a hot swap). Label `concurrency` too: under
+// ThreadSanitizer with OpenCV kept on our threads (own_threads_only), so that TSan checks the
+// RT side against the worker and the hand-over between workers.
 #include "camera_worker.h"
 
 #include <doctest/doctest.h>
@@ -62,6 +64,7 @@ CameraWorker::Take poll(CameraWorker& w, CameraWorker::Published& p, bool reques
 }  // namespace
 
 TEST_CASE("each requested frame is published once, with per-camera flags; the end is reported") {
+  crease::vision::testing::own_threads_only();
   crease::vision::testing::Scene s;
   const auto dir = std::filesystem::temp_directory_path() /
                    ("crease_camera_worker_" + std::to_string(::getpid()));
@@ -73,6 +76,7 @@ TEST_CASE("each requested frame is published once, with per-camera flags; the en
   {
     CameraWorker w(std::make_unique<FlakySource>(renderer(s), s.flat(), 3), ch, dir.string());
     CHECK(ch->writer_claimed());
+    CHECK(crease::vision::testing::process_threads() == 2);  // this one and the worker
     const auto before = crease::rt::rt_allocation_count();
     CameraWorker::Published p;
     CameraWorker::Take t = CameraWorker::Take::none;
@@ -109,6 +113,7 @@ TEST_CASE("each requested frame is published once, with per-camera flags; the en
 }
 
 TEST_CASE("a new worker waits for the old one's writer end (hot swap), then publishes") {
+  crease::vision::testing::own_threads_only();
   crease::vision::testing::Scene s;
   auto ch = std::make_shared<crease::frames::FrameChannel>("camera_worker_test.swap",
                                                            channel_specs(small_rig()));
@@ -132,6 +137,7 @@ TEST_CASE("a new worker waits for the old one's writer end (hot swap), then publ
           CameraWorker::Take::none);  // still waiting for the writer end
   }
   CHECK(ch->published() == 2);
+  CHECK(crease::vision::testing::process_threads() == 3);  // this one and the two workers: ours
   old_worker.reset();  // the old instance goes: its worker releases the writer end
   REQUIRE(poll(fresh, p) == CameraWorker::Take::fresh);
   CHECK(p.sequence == 3);  // the channel's sequence goes on

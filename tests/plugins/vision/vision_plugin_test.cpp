@@ -70,9 +70,11 @@ struct Fixture {
     s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
     host.add_instance(s);
   }
-  void add_vision(const std::string& cameras_dir, const std::string& channel) {
+  void add_vision(const std::string& cameras_dir, const std::string& channel,
+                  const std::string& more = "") {
     add("vision", "vision", 10,
-        "{cameras: '" + cameras_dir + "', channel: " + channel + ", layout: markers/layout.yaml}");
+        "{cameras: '" + cameras_dir + "', channel: " + channel + ", layout: markers/layout.yaml" +
+            more + "}");
   }
   const crease::Keypoints& read() {
     const auto* ch = host.ports().find_latest("keypoints");
@@ -194,7 +196,7 @@ TEST_CASE("camera_sim -> vision with the shipped cameras and layout, recording w
   fx.add("cameras", "camera_sim", 5,
          "{occluders: 1, fold_start_s: 0, fold_duration_s: 1, channel: sim, record: '" +
              rec.string() + "'}");
-  fx.add_vision("cameras", "sim");
+  fx.add_vision("cameras", "sim", ", camera_threads: 3");  // cameras on threads of ours
   fx.host.start();
   REQUIRE(fx.wait_for([&] { return fx.read().frame >= 2; }));
   CHECK(fx.read().count > 100);

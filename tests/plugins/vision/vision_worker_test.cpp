@@ -1,5 +1,8 @@
 // VisionWorker: woken by each set published into a frame channel, key-points handed to the RT
-// side without allocation; calibrations that do not match the channel are refused.
+// side without allocation; calibrations that do not match the channel are refused. Label
+// `concurrency` too: under ThreadSanitizer with OpenCV kept on our threads (own_threads_only),
+// TSan checks the channel hand-over (this thread writes, the worker reads) and the result
+// hand-off to the RT side.
 #include "vision_worker.h"
 
 #include <doctest/doctest.h>
@@ -24,6 +27,7 @@ std::vector<Camera> small_rig() {
 }  // namespace
 
 TEST_CASE("each published set is detected once, without allocating on the RT side") {
+  crease::vision::testing::own_threads_only();
   crease::vision::testing::Scene s;
   const ViewRenderer r(face_texture(s.layout, Face::kFront, 4),
                        face_texture(s.layout, Face::kBack, 4), 4, small_rig());
@@ -69,6 +73,7 @@ TEST_CASE("each published set is detected once, without allocating on the RT sid
   CHECK(first_count > 20);  // key-points seen by both cameras
   CHECK(ch->consumed() == 4);
   CHECK(w.sets_processed() == 4);
+  CHECK(crease::vision::testing::process_threads() == 2);  // this one and the worker: no TBB
   if (crease::rt::alloc_hooks_installed()) {  // the counter would have seen an allocation
     crease::rt::ScopedRtMark mark;
     static char* volatile sink;  // keeps the allocation from being elided
@@ -88,4 +93,39 @@ TEST_CASE("calibrations that do not match the channel are refused; the reader en
                        doctest::Contains("'vision_worker_test.b'"), std::invalid_argument);
   { VisionWorker w(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}); }
   CHECK_FALSE(ch->reader_claimed());
+}
+
+TEST_CASE("cameras detected on helper threads of ours give the same key-points as one by one") {
+  crease::vision::testing::own_threads_only();
+  crease::vision::testing::Scene s;
+  const ViewRenderer r(face_texture(s.layout, Face::kFront, 4),
+                       face_texture(s.layout, Face::kBack, 4), 4, small_rig());
+  auto ch = std::make_shared<crease::frames::FrameChannel>("vision_worker_test.team",
+                                                           channel_specs(small_rig()));
+  REQUIRE(ch->try_claim_writer());
+  std::vector<RenderedView> views(2);
+  for (int k = 0; k < 2; ++k)
+    r.render(k, s.flat(), RenderOptions{}, views[static_cast<std::size_t>(k)]);
+  std::vector<std::unique_ptr<crease::Keypoints>> kps;
+  for (const int threads : {1, 2}) {
+    CAPTURE(threads);
+    for (std::size_t k = 0; k < 2; ++k)  // the same images for each worker
+      std::memcpy(ch->write_slot().pixels(k), views[k].image.data, ch->image_bytes(k));
+    ch->publish(7, 0, 0x3u);
+    VisionWorker w(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}, threads);
+    kps.push_back(std::make_unique<crease::Keypoints>());
+    VisionWorker::Take t = VisionWorker::Take::none;
+    for (int i = 0; i < 5000 && t == VisionWorker::Take::none; ++i) {
+      t = w.take_rt(*kps.back());
+      if (t == VisionWorker::Take::none) std::this_thread::sleep_for(1ms);
+    }
+    REQUIRE(t == VisionWorker::Take::fresh);
+    // This thread, the worker and its threads - 1 helpers: all ours.
+    CHECK(crease::vision::testing::process_threads() == 1 + threads);
+  }
+  REQUIRE(kps[0]->count > 20);
+  REQUIRE(kps[0]->count == kps[1]->count);
+  CHECK(std::memcmp(kps[0]->points, kps[1]->points, sizeof(crease::Keypoint) * kps[0]->count) == 0);
+  CHECK_THROWS_AS(VisionWorker(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}, -1),
+                  std::invalid_argument);
 }
