@@ -35,19 +35,6 @@ constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 
 }  // namespace
 
-namespace mockwire {
-socklen_t make_address(const std::string& bus_name, sockaddr_un& out) {
-  const std::string path = std::string("crease-can/") + bus_name;
-  if (bus_name.empty() || path.size() + 1 > sizeof(out.sun_path)) {
-    throw std::invalid_argument("mock CAN bus name '" + bus_name + "' is empty or too long");
-  }
-  std::memset(&out, 0, sizeof(out));
-  out.sun_family = AF_UNIX;
-  std::memcpy(out.sun_path + 1, path.data(), path.size());  // abstract namespace: leading NUL
-  return static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + path.size());
-}
-}  // namespace mockwire
-
 // The broker's state; the process's reactor thread drives it (mockwire::BrokerCore).
 struct MockCanBroker::Impl final : mockwire::BrokerCore {
   MockCanBrokerConfig cfg;
@@ -239,20 +226,8 @@ struct MockCanBroker::Impl final : mockwire::BrokerCore {
     c.shm = shm;
     Record w;
     w.kind = mockwire::kWelcome;
-    iovec iov{&w, sizeof(w)};
-    alignas(cmsghdr) char ctl[CMSG_SPACE(2 * sizeof(int))] = {};
-    msghdr mh{};
-    mh.msg_iov = &iov;
-    mh.msg_iovlen = 1;
-    mh.msg_control = ctl;
-    mh.msg_controllen = sizeof(ctl);
-    cmsghdr* cm = CMSG_FIRSTHDR(&mh);
-    cm->cmsg_level = SOL_SOCKET;
-    cm->cmsg_type = SCM_RIGHTS;
-    cm->cmsg_len = CMSG_LEN(2 * sizeof(int));
     const int fds[2] = {reactor->doorbell_fd(), reactor->page_fd()};
-    std::memcpy(CMSG_DATA(cm), fds, sizeof(fds));
-    if (::sendmsg(c.fd, &mh, MSG_DONTWAIT | MSG_NOSIGNAL) != sizeof(w)) return false;
+    if (mockwire::send_record(c.fd, w, fds, 2, MSG_DONTWAIT) != sizeof(w)) return false;
     c.node = r.frame.can_id;
     return true;
   }
@@ -269,7 +244,6 @@ struct MockCanBroker::Impl final : mockwire::BrokerCore {
   }
 
   void on_fd(int fd, std::uint32_t ev, std::int64_t now) override {
-    (void)now;
     std::lock_guard lk(mu);
     if (fd == listen_fd) {
       accept_all();
@@ -281,14 +255,9 @@ struct MockCanBroker::Impl final : mockwire::BrokerCore {
     bool closed = (ev & (EPOLLHUP | EPOLLERR)) != 0 && !(ev & EPOLLIN);
     for (int k = 0; k < 16 && (ev & EPOLLIN); ++k) {
       Record r;
-      iovec iov{&r, sizeof(r)};
-      alignas(cmsghdr) char ctl[CMSG_SPACE(sizeof(int))] = {};
-      msghdr mh{};
-      mh.msg_iov = &iov;
-      mh.msg_iovlen = 1;
-      mh.msg_control = ctl;
-      mh.msg_controllen = sizeof(ctl);
-      const ssize_t got = ::recvmsg(fd, &mh, MSG_DONTWAIT | MSG_CMSG_CLOEXEC);
+      int fds[mockwire::kMaxFds];
+      const ssize_t got = mockwire::recv_record(fd, r, fds, MSG_DONTWAIT);
+      if (fds[1] >= 0) ::close(fds[1]);  // a hello carries one descriptor
       if (got == 0) {
         closed = true;
         break;
@@ -297,45 +266,55 @@ struct MockCanBroker::Impl final : mockwire::BrokerCore {
         if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) closed = true;
         break;
       }
-      int shm_fd = -1;
-      for (cmsghdr* cm = CMSG_FIRSTHDR(&mh); cm; cm = CMSG_NXTHDR(&mh, cm)) {
-        if (cm->cmsg_level == SOL_SOCKET && cm->cmsg_type == SCM_RIGHTS) std::memcpy(&shm_fd, CMSG_DATA(cm), sizeof(int));
-      }
+      const int shm_fd = fds[0];
       if (got == sizeof(r) && r.kind == mockwire::kHello) {
         if (!on_hello(c, r, shm_fd)) closed = true;
       } else if (shm_fd >= 0) {
         ::close(shm_fd);  // malformed: ignored
       }
     }
-    if (closed) remove_client(fd);
+    if (closed) {
+      // What the node sent before it hung up still goes out, as a CAN controller transmits
+      // the frames already queued when a socket closes.
+      std::int64_t first_sent = now;
+      (void)read_tx(c, now, static_cast<int>(mockwire::kTxRing), first_sent);
+      remove_client(fd);
+    }
     stats.nodes = static_cast<int>(std::count_if(clients.begin(), clients.end(), [](const auto& x) { return x->node != kNoNode; }));
   }
 
   // --- the tick -----------------------------------------------------------------------------
+  // Takes up to `max` records off a node's tx ring onto the bus; lowers `first_sent` to the
+  // earliest send time among them. True if any moved.
+  bool read_tx(Client& c, std::int64_t now, int max, std::int64_t& first_sent) {
+    if (!c.shm) return false;
+    bool moved = false;
+    Record r;
+    for (int k = 0; k < max && c.shm->tx.try_pop(r); ++k) {
+      moved = true;
+      if (r.timestamp_ns > 0 && r.timestamp_ns < first_sent) first_sent = r.timestamp_ns;
+      if (r.kind == mockwire::kRestart) {
+        if (c.bus_off) {
+          c.bus_off = false;
+          Record e;
+          e.frame = make_error_frame_for_state(BusState::error_active);
+          e.timestamp_ns = now;
+          send_to(c, e);
+        }
+      } else if (r.kind == mockwire::kData) {
+        on_frame(c, r, now);
+      }
+    }
+    return moved;
+  }
+
   std::int64_t tick(std::int64_t now) override {
     std::lock_guard lk(mu);
     const std::uint64_t forwarded_before = stats.forwarded, received_before = stats.received;
     bool moved = false;
     std::int64_t first_sent = now;  // nodes stamp their send time on the records
     for (std::size_t i = 0; i < clients.size() && reading; ++i) {
-      Client& c = *clients[i];
-      if (!c.shm) continue;
-      Record r;
-      for (int k = 0; k < kReadBatch && c.shm->tx.try_pop(r); ++k) {
-        moved = true;
-        if (r.timestamp_ns > 0 && r.timestamp_ns < first_sent) first_sent = r.timestamp_ns;
-        if (r.kind == mockwire::kRestart) {
-          if (c.bus_off) {
-            c.bus_off = false;
-            Record e;
-            e.frame = make_error_frame_for_state(BusState::error_active);
-            e.timestamp_ns = now;
-            send_to(c, e);
-          }
-        } else if (r.kind == mockwire::kData) {
-          on_frame(c, r, now);
-        }
-      }
+      if (read_tx(*clients[i], now, kReadBatch, first_sent)) moved = true;
     }
     for (std::uint32_t node : bus_off_requests) {
       for (auto& c : clients) {

@@ -43,19 +43,7 @@ MockCanBus::MockCanBus(MockCanBusConfig cfg) : cfg_(std::move(cfg)) {
   mockwire::Record hello;
   hello.kind = mockwire::kHello;
   hello.frame.can_id = cfg_.node_id;
-  iovec iov{&hello, sizeof(hello)};
-  alignas(cmsghdr) char ctl[CMSG_SPACE(2 * sizeof(int))] = {};
-  msghdr mh{};
-  mh.msg_iov = &iov;
-  mh.msg_iovlen = 1;
-  mh.msg_control = ctl;
-  mh.msg_controllen = CMSG_SPACE(sizeof(int));
-  cmsghdr* cm = CMSG_FIRSTHDR(&mh);
-  cm->cmsg_level = SOL_SOCKET;
-  cm->cmsg_type = SCM_RIGHTS;
-  cm->cmsg_len = CMSG_LEN(sizeof(int));
-  std::memcpy(CMSG_DATA(cm), &shm_fd, sizeof(int));
-  const ssize_t sent = ::sendmsg(fd_, &mh, MSG_NOSIGNAL);
+  const ssize_t sent = mockwire::send_record(fd_, hello, &shm_fd, 1, 0);
   const int send_errno = errno;
   ::close(shm_fd);
   if (sent != sizeof(hello)) fail("hello", send_errno);
@@ -63,20 +51,9 @@ MockCanBus::MockCanBus(MockCanBusConfig cfg) : cfg_(std::move(cfg)) {
   pollfd pfd{fd_, POLLIN, 0};
   if (::poll(&pfd, 1, 5000) <= 0) fail("no welcome from the broker", ETIMEDOUT);
   mockwire::Record welcome;
-  iov = {&welcome, sizeof(welcome)};
-  std::memset(ctl, 0, sizeof(ctl));
-  mh = {};
-  mh.msg_iov = &iov;
-  mh.msg_iovlen = 1;
-  mh.msg_control = ctl;
-  mh.msg_controllen = sizeof(ctl);
-  const ssize_t got = ::recvmsg(fd_, &mh, MSG_CMSG_CLOEXEC);
+  int fds[mockwire::kMaxFds];
+  const ssize_t got = mockwire::recv_record(fd_, welcome, fds, 0);
   const int recv_errno = errno;
-  int fds[2] = {-1, -1};
-  cm = got > 0 ? CMSG_FIRSTHDR(&mh) : nullptr;
-  if (cm && cm->cmsg_level == SOL_SOCKET && cm->cmsg_type == SCM_RIGHTS && cm->cmsg_len == CMSG_LEN(2 * sizeof(int))) {
-    std::memcpy(fds, CMSG_DATA(cm), sizeof(fds));
-  }
   if (got != sizeof(welcome) || welcome.kind != mockwire::kWelcome || fds[0] < 0 || fds[1] < 0) {
     for (int fd : fds) {
       if (fd >= 0) ::close(fd);

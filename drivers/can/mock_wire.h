@@ -109,4 +109,11 @@ struct ReactorShm {
 // name is empty or too long.
 socklen_t make_address(const std::string& bus_name, sockaddr_un& out);
 
+// One Record and up to kMaxFds descriptors (SCM_RIGHTS) over the control socket: the hello and
+// the welcome. Both return sendmsg's / recvmsg's result, errno as the call left it.
+inline constexpr int kMaxFds = 2;
+ssize_t send_record(int sock, const Record& r, const int* fds, int nfds, int flags) noexcept;
+// The descriptors arrive close-on-exec; a slot no descriptor came for is -1.
+ssize_t recv_record(int sock, Record& r, int (&fds)[kMaxFds], int flags) noexcept;
+
 }  // namespace crease::drivers::mockwire

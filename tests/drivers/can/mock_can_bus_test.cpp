@@ -297,6 +297,27 @@ TEST_CASE("a send after an idle pause wakes the broker thread; sends right after
   CHECK(drain_ids(b) == std::vector<std::uint32_t>{1, 2, 3});
 }
 
+TEST_CASE("frames a node sent just before it closed still reach the bus") {
+  const std::string name = unique_bus("closing");
+  MockCanBroker broker({name, 0, 0, false});
+  auto a = std::make_unique<MockCanBus>(node(name, 1));
+  MockCanBus b(node(name, 2));
+  require_nodes(broker, 2);
+  for (int round = 0; round < 20; ++round) {
+    ::usleep(2'000);  // let the broker thread fall asleep: the hang-up and the doorbell then
+                      // arrive together, and the hang-up is handled first
+    const CanFrame burst[3] = {frame_with_id(3 * round + 1), frame_with_id(3 * round + 2), frame_with_id(3 * round + 3)};
+    SendResult last;
+    REQUIRE(a->send_batch(burst, &last) == 3);
+    a.reset();
+    const std::vector<std::uint32_t> want{std::uint32_t(3 * round + 1), std::uint32_t(3 * round + 2),
+                                          std::uint32_t(3 * round + 3)};
+    CHECK(drain_ids(b) == want);
+    a = std::make_unique<MockCanBus>(node(name, 1));
+    require_nodes(broker, 2);
+  }
+}
+
 TEST_CASE("brokers of one process share a thread; closing one leaves the others working") {
   const std::string n1 = unique_bus("shared"), n2 = unique_bus("shared"), n3 = unique_bus("shared");
   MockCanBroker b1({n1, 0, 0, false}), b3({n3, 0, 0, false});
