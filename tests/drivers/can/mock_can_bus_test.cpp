@@ -54,11 +54,13 @@ TEST_CASE("connecting to a bus nobody serves throws, naming the bus") {
 
 TEST_CASE("a full transmit queue gives no_buffers (ENOBUFS emulation) and drains at the bitrate") {
   const std::string name = unique_bus("enobufs");
-  MockCanBroker broker({name, 125'000, 125'000, false});
-  MockCanBus a(node(name, 1, 125'000)), b(node(name, 2, 125'000));
+  // 10 kbit/s (~11 ms a frame) so that a slow or descheduled test thread (sanitizers, a loaded
+  // machine) still queues the frames back to back.
+  MockCanBroker broker({name, 10'000, 10'000, false});
+  MockCanBus a(node(name, 1, 10'000)), b(node(name, 2, 10'000));
   require_nodes(broker, 2);
   const std::uint8_t b8[8] = {};
-  const CanFrame f = CanFrame::classic(0x100, b8);  // ~1 ms each at 125 kbit/s
+  const CanFrame f = CanFrame::classic(0x100, b8);
   int ok = 0;
   SendResult last = SendResult::ok;
   for (int i = 0; i < 20; ++i) {
@@ -69,14 +71,14 @@ TEST_CASE("a full transmit queue gives no_buffers (ENOBUFS emulation) and drains
   CHECK(ok == MockCanBus::kTxQueueLen);
   CHECK(last == SendResult::no_buffers);
   CHECK(a.counters().tx_no_buffers == 1);
-  ::usleep(3000);  // a few frames have left the queue
+  ::usleep(30'000);  // two frames have left the queue
   CHECK(a.send(f) == SendResult::ok);
   // Bus-load model: receive timestamps are one frame time apart.
   RxFrame r1, r2;
   REQUIRE(recv_wait(b, r1) == RecvResult::frame);
   REQUIRE(recv_wait(b, r2) == RecvResult::frame);
   const std::int64_t dt = r2.timestamp_ns - r1.timestamp_ns;
-  CHECK(dt == can_frame_time_ns(f, 125'000, 125'000));
+  CHECK(dt == can_frame_time_ns(f, 10'000, 10'000));
 }
 
 TEST_CASE("seeded faults: drop, duplicate, reorder, corrupt are reproducible") {
