@@ -32,6 +32,7 @@
 #include "drivers/simdevice/sim_arm.h"
 #include "drivers/simdevice/sim_clock.h"
 #include "drivers/simdevice/sim_hand.h"
+#include "rt/clock.h"
 
 namespace {
 using namespace crease::drivers;
@@ -262,15 +263,10 @@ std::vector<double> control_cycle(int cycles) {
   hand::Stiffness hs;
   arm::Command ac;
   std::vector<double> us;
-  timespec next{};
-  clock_gettime(CLOCK_MONOTONIC, &next);
+  std::int64_t next = crease::rt::now_ns();
   for (int c = 0; c < cycles + 300; ++c) {
-    next.tv_nsec += 1'000'000;
-    if (next.tv_nsec >= 1'000'000'000) {
-      next.tv_nsec -= 1'000'000'000;
-      ++next.tv_sec;
-    }
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    next += 1'000'000;
+    crease::rt::sleep_until_ns(next);
     const std::int64_t t = now_ns();
     for (auto& h : hands) h.read_from_rt(t);
     for (auto& a : arms) a.read_from_rt(t);
@@ -312,15 +308,10 @@ std::vector<double> syscall_floor(int cycles) {
   }
   std::vector<double> us;
   CanFrame f[2];
-  timespec next{};
-  clock_gettime(CLOCK_MONOTONIC, &next);
+  std::int64_t next = crease::rt::now_ns();
   for (int c = 0; c < cycles + 100; ++c) {
-    next.tv_nsec += 1'000'000;
-    if (next.tv_nsec >= 1'000'000'000) {
-      next.tv_nsec -= 1'000'000'000;
-      ++next.tv_sec;
-    }
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    next += 1'000'000;
+    crease::rt::sleep_until_ns(next);
     const std::int64_t t = now_ns();
     for (auto& s : sv) (void)!::recv(s[0], &f[0], sizeof(f[0]), MSG_DONTWAIT);
     for (auto& s : sv) {

@@ -95,15 +95,17 @@ TrackResult track(Engine& e, const FoldScript& truth, const std::vector<Vec2>& k
   return r;
 }
 
-// Ours: XPBD, seed 000 topology, table + self-collision, crease on the fold line, targets
-// as zero-length springs (seed 001 Eq. 4).
-struct Ours {
-  SheetParams p;
+// A Crease sheet on the table with a crease on the fold line, targets set every frame, one
+// step_rt per 1/60 s frame. Ours: XPBD, seed 000 topology, self-collision, targets as zero-length
+// springs (seed 001 Eq. 4) (XpbdSheet); the ODE backend: the same model from ODE bodies and soft
+// distance joints (OdeSheet).
+template <class Sheet>
+struct CreaseEngine {
   CollisionWorld world;
-  std::unique_ptr<XpbdSheet> s;
-  explicit Ours(const SheetParams& params) : p(params) {
+  std::unique_ptr<Sheet> s;
+  explicit CreaseEngine(const SheetParams& p) {
     world.add_table(0.0);
-    s = std::make_unique<XpbdSheet>(p);
+    s = std::make_unique<Sheet>(p);
     s->set_collision_world(&world);
     s->add_crease({{0, p.grid.height_mm / 2}, {p.grid.width_mm, p.grid.height_mm / 2}});
   }
@@ -113,23 +115,8 @@ struct Ours {
             [this](std::vector<Vec3>& x) { x.assign(s->positions().begin(), s->positions().end()); }};
   }
 };
-
-// The ODE backend: the same model from ODE bodies and soft distance joints.
-struct OdeEngine {
-  CollisionWorld world;
-  std::unique_ptr<OdeSheet> s;
-  explicit OdeEngine(const SheetParams& p) {
-    world.add_table(0.0);
-    s = std::make_unique<OdeSheet>(p);
-    s->set_collision_world(&world);
-    s->add_crease({{0, p.grid.height_mm / 2}, {p.grid.width_mm, p.grid.height_mm / 2}});
-  }
-  Engine engine() {
-    return {[this](std::span<const TargetPoint> t) { s->set_targets(t); },
-            [this] { s->step_rt(kFrame); },
-            [this](std::vector<Vec3>& x) { x.assign(s->positions().begin(), s->positions().end()); }};
-  }
-};
+using Ours = CreaseEngine<XpbdSheet>;
+using OdeEngine = CreaseEngine<OdeSheet>;
 
 // Bullet 3.24 soft body with the same nodes, links and masses, in metres; ICL's settings:
 // linear stiffness 0.9 (0.001 across the crease), as many position iterations as our
