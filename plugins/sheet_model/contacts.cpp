@@ -96,7 +96,7 @@ void ContactSolver::configure(const Topology& topo, const GridParams& grid, cons
   const int n = topo.grid.count();
   shape_pairs_.resize(static_cast<std::size_t>(n) * kMaxContactsPerNode);
   self_pairs_.resize(static_cast<std::size_t>(n) * 16);
-  shape_active_.resize(shape_pairs_.size());
+  shape_active_.reserve(static_cast<int>(shape_pairs_.size()));
   self_active_.resize(self_pairs_.size());
   cand_tris_.assign(static_cast<std::size_t>(topo.triangle_count()), 0);
   tri_stamp_.assign(static_cast<std::size_t>(topo.triangle_count()), 0);
@@ -146,8 +146,8 @@ void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* wor
   }
   n_self_ = 0;
   if (self_enabled_) detect_self_rt(x, margin_mm, std::max(0.0, lateral_mm));
-  std::copy_n(shape_pairs_.begin(), n_shape_, shape_active_.begin());
-  n_shape_active_ = n_shape_;
+  shape_active_.clear();
+  for (int k = 0; k < n_shape_; ++k) shape_active_.push(shape_pairs_[k].node, shape_pairs_[k].normal, shape_pairs_[k].offset);
   std::copy_n(self_pairs_.begin(), n_self_, self_active_.begin());
   n_self_active_ = n_self_;
   ++stamp_;
@@ -162,17 +162,17 @@ void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* wor
     tri_stamp_[t] = stamp_;
     cand_tris_[n_cand_tris_++] = t;
   }
-  stats_.shape_contacts = n_shape_active_;
+  stats_.shape_contacts = shape_active_.size();
   stats_.self_pairs = n_self_active_;
   stats_.self_candidates = n_self_;
 }
 
 void ContactSolver::select_rt(std::span<const Vec3> x, double margin_mm) noexcept {
   const double rs = half_thickness_ + margin_mm;
-  n_shape_active_ = 0;
+  shape_active_.clear();
   for (int k = 0; k < n_shape_; ++k) {
     const ShapePair& c = shape_pairs_[k];
-    if (dot(c.normal, x[c.node]) - c.offset < rs) shape_active_[n_shape_active_++] = c;
+    if (dot(c.normal, x[c.node]) - c.offset < rs) shape_active_.push(c.node, c.normal, c.offset);
   }
   const double reach = thickness_ + margin_mm;
   const auto& tri = topo_->tri;
@@ -195,7 +195,7 @@ void ContactSolver::select_rt(std::span<const Vec3> x, double margin_mm) noexcep
     if (!barycentric(xp, a, x[tri[3 * c.tri + 1]], x[tri[3 * c.tri + 2]], n, nn, bary)) continue;
     self_active_[n_self_active_++] = {c.node, c.tri, dn >= 0 ? 1.0 : -1.0};
   }
-  stats_.shape_contacts = n_shape_active_;
+  stats_.shape_contacts = shape_active_.size();
   stats_.self_pairs = n_self_active_;
 }
 
@@ -345,24 +345,8 @@ void ContactSolver::detect_self_rt(std::span<const Vec3> x, double margin_mm, do
 
 void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w,
                              bool with_self) noexcept {
-  // Nodes against rigid shapes: push out to half the thickness, then Coulomb friction on
-  // the substep's tangential displacement.
-  for (int k = 0; k < n_shape_active_; ++k) {
-    const ShapePair& c = shape_active_[k];
-    if (w[c.node] <= 0) continue;
-    Vec3& p = x[c.node];
-    const double pen = c.offset + half_thickness_ - dot(c.normal, p);
-    if (pen <= 0) continue;
-    p += pen * c.normal;
-    Vec3 dt = p - prev[c.node];
-    dt -= dot(dt, c.normal) * c.normal;
-    const double slide2 = dot(dt, dt), stick = friction_ * pen;
-    if (slide2 <= stick * stick) {
-      p -= dt;
-    } else if (slide2 > 0) {
-      p -= (stick / std::sqrt(slide2)) * dt;
-    }
-  }
+  // Nodes against rigid shapes: push out to half the thickness, then Coulomb friction.
+  shape_active_.solve_rt(x, prev, w, half_thickness_, friction_);
   if (!with_self) return;
   // Nodes against triangles of other layers: keep the frame's side, thickness apart.
   const auto& tri = topo_->tri;

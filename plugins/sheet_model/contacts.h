@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "collision_world.h"
+#include "shape_contacts.h"
 #include "sheet_params.h"
 #include "topology.h"
 #include "vec3.h"
@@ -54,7 +55,10 @@ class ContactSolver {
 
   [[nodiscard]] const ContactStats& stats() const noexcept { return stats_; }
   // Screens nodes without AVX2 even when the CPU has it (tests compare the two).
-  void force_scalar(bool on) noexcept { use_simd_ = has_simd_ && !on; }
+  void force_scalar(bool on) noexcept {
+    use_simd_ = has_simd_ && !on;
+    shape_active_.force_scalar(on);
+  }
 
  private:
   struct ShapePair {
@@ -77,8 +81,7 @@ class ContactSolver {
   int n_shape_ = 0;
   std::vector<SelfPair> self_pairs_;
   int n_self_ = 0;
-  std::vector<ShapePair> shape_active_;  // selected each frame from shape_pairs_ / self_pairs_
-  int n_shape_active_ = 0;
+  ShapeContacts shape_active_;  // selected each frame from shape_pairs_ (self_active_: self_pairs_)
   std::vector<SelfPair> self_active_;
   int n_self_active_ = 0;
   std::vector<std::int32_t> cand_tris_;  // distinct triangles of self_pairs_

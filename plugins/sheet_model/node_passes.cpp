@@ -1,5 +1,6 @@
 #include "node_passes.h"
 
+#include <algorithm>
 #include <cmath>
 
 #if defined(__x86_64__)
@@ -23,9 +24,10 @@ void predict_scalar(Vec3* x, Vec3* v, Vec3* prev, const Vec3* pin, const std::in
 }
 
 // Speed limit and pinned nodes, node by node from `first` (the velocities of nodes before
-// `first` are already (x - prev) / dts, pinned ones 0).
+// `first` are already (x - prev) / dts, pinned ones 0, and none of their components exceeds
+// sqrt(max_c2): when 3 max_c2 <= vcap^2, none of them is over the speed limit).
 void finish_velocities(Vec3* x, Vec3* v, const Vec3* prev, const std::int64_t* keep, double dts, double vcap,
-                       int first, int n) noexcept {
+                       int first, double max_c2, int n) noexcept {
   const double inv = 1.0 / dts;
   for (int i = first; i < n; ++i) {
     if (keep[3 * i] == 0) {
@@ -34,7 +36,8 @@ void finish_velocities(Vec3* x, Vec3* v, const Vec3* prev, const std::int64_t* k
     }
     v[i] = inv * (x[i] - prev[i]);
   }
-  for (int i = 0; i < n; ++i) {
+  const int from = 3.0 * max_c2 <= vcap * vcap ? first : 0;
+  for (int i = from; i < n; ++i) {
     const double sp2 = dot(v[i], v[i]);
     if (sp2 > vcap * vcap) {  // the move of this substep is shortened too
       v[i] *= vcap / std::sqrt(sp2);
@@ -74,16 +77,25 @@ __attribute__((target("avx2,fma"))) void predict_avx2(double* x, double* v, doub
   }
 }
 
-// Velocities of whole 4-double groups; returns the first node not fully covered.
+// Velocities of whole 4-double groups; returns the first node not fully covered and the
+// largest squared component among the groups' velocities in max_c2 (a NaN velocity is never
+// capped, so it need not show there).
 __attribute__((target("avx2,fma"))) int velocities_avx2(const double* x, double* v, const double* prev,
-                                                        const std::int64_t* keep, double dts, int m) noexcept {
+                                                        const std::int64_t* keep, double dts, int m,
+                                                        double& max_c2) noexcept {
   const __m256d inv = _mm256_set1_pd(1.0 / dts);
+  __m256d mx = _mm256_setzero_pd();
   int k = 0;
   for (; k + 4 <= m; k += 4) {
     const __m256d free = _mm256_castsi256_pd(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(keep + k)));
-    const __m256d vn = _mm256_mul_pd(inv, _mm256_sub_pd(_mm256_loadu_pd(x + k), _mm256_loadu_pd(prev + k)));
-    _mm256_storeu_pd(v + k, _mm256_and_pd(vn, free));
+    const __m256d vn = _mm256_and_pd(_mm256_mul_pd(inv, _mm256_sub_pd(_mm256_loadu_pd(x + k), _mm256_loadu_pd(prev + k))), free);
+    _mm256_storeu_pd(v + k, vn);
+    mx = _mm256_max_pd(mx, _mm256_mul_pd(vn, vn));
   }
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, mx);
+  max_c2 = 0.0;
+  for (const double c : lanes) max_c2 = std::max(max_c2, c);
   return k / 3;
 }
 
@@ -93,7 +105,10 @@ bool cpu_avx2_fma() noexcept {
 }
 #else
 void predict_avx2(double*, double*, double*, const double*, const std::int64_t*, Vec3, double, double, int) noexcept {}
-int velocities_avx2(const double*, double*, const double*, const std::int64_t*, double, int) noexcept { return 0; }
+int velocities_avx2(const double*, double*, const double*, const std::int64_t*, double, int, double& max_c2) noexcept {
+  max_c2 = 0.0;
+  return 0;
+}
 bool cpu_avx2_fma() noexcept { return false; }
 #endif
 
@@ -117,8 +132,9 @@ void update_velocities_rt(std::span<Vec3> x, std::span<Vec3> v, std::span<const 
                           std::span<const std::int64_t> keep, double dts, double vcap, bool simd) noexcept {
   const int n = static_cast<int>(x.size());
   if (n == 0) return;
-  const int first = simd ? velocities_avx2(&x[0].x, &v[0].x, &prev[0].x, keep.data(), dts, 3 * n) : 0;
-  finish_velocities(x.data(), v.data(), prev.data(), keep.data(), dts, vcap, first, n);
+  double max_c2 = 0.0;
+  const int first = simd ? velocities_avx2(&x[0].x, &v[0].x, &prev[0].x, keep.data(), dts, 3 * n, max_c2) : 0;
+  finish_velocities(x.data(), v.data(), prev.data(), keep.data(), dts, vcap, first, max_c2, n);
 }
 
 }  // namespace crease::sheet

@@ -82,7 +82,8 @@ void check_default_sheet(int max_simd_width) {
   const Topology t = build_topology(GridParams{}, TopologyParams{});
   LinkKernel k;
   k.configure(t, max_simd_width);
-  MESSAGE("batches=" << k.batch_count() << " lanes=" << k.lane_count() << " width=" << k.max_width());
+  const int width = k.max_width();
+  MESSAGE("batches=" << k.batch_count() << " lanes=" << k.lane_count() << " width=" << width);
   CHECK(k.lane_count() >= t.link_count());
   std::vector<double> rest(t.link_count());
   const Grid& g = t.grid;
@@ -111,7 +112,9 @@ void check_default_sheet(int max_simd_width) {
     moved = std::max(moved, dist(x0[n], xs[n]));
   }
   CHECK(moved > 0.1);    // the pass did something
-  CHECK(diff < 1e-3);    // the same order; rsqrt + Newton vs sqrt in float
+  // The same order; 1/|d| in float from sqrt vs rsqrt + Newton (AVX2) or rsqrt14 alone
+  // (AVX-512, relative error <= 2^-14 per link move): an order mistake moves nodes by ~0.1 mm.
+  CHECK(diff < (width == 16 ? 1e-2 : 1e-3));
   // Every link takes part: passes must shrink the worst strain.
   const double e0 = max_strain(x0);
   for (int it = 0; it < 200; ++it) k.project_rt(xs);
