@@ -16,16 +16,9 @@ namespace {
 constexpr int kMaxContactsPerNode = 4;
 constexpr double kBaryTolerance = 0.05;  // accept projections slightly outside a triangle
 
-// Barycentric coordinates of p's projection onto the plane of (a, b, c), from the signed
-// areas: n = (b - a) x (c - a), nn = |n|^2 > 0. True when inside (with tolerance).
 bool barycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, double nn,
                  double out[3]) {
-  const double inv = 1.0 / nn;
-  const Vec3 pa = a - p, pb = b - p, pc = c - p;
-  out[0] = dot(cross(pb, pc), n) * inv;
-  out[1] = dot(cross(pc, pa), n) * inv;
-  out[2] = 1.0 - out[0] - out[1];
-  return out[0] >= -kBaryTolerance && out[1] >= -kBaryTolerance && out[2] >= -kBaryTolerance;
+  return barycentric_inside(p, a, b, c, n, nn, kBaryTolerance, out);
 }
 
 constexpr double kMinArea2 = 1e-12;  // mm^4: |n|^2 of a degenerate triangle
@@ -124,6 +117,8 @@ void ContactSolver::configure(const Topology& topo, const GridParams& grid, cons
   has_simd_ = __builtin_cpu_supports("avx2");
 #endif
   use_simd_ = has_simd_;
+  has_select_simd_ = layer_select_simd_available();
+  use_select_simd_ = has_select_simd_;
   cell_mm_ = std::hypot(topo.grid.du, topo.grid.dv) + 2.0 * thickness_;
 }
 
@@ -181,20 +176,8 @@ void ContactSolver::select_rt(std::span<const Vec3> x, double margin_mm) noexcep
     const Vec3 a = x[tri[3 * t]];
     tri_n_[t] = cross(x[tri[3 * t + 1]] - a, x[tri[3 * t + 2]] - a);
   }
-  n_self_active_ = 0;
-  for (int k = 0; k < n_self_; ++k) {
-    const SelfPair& c = self_pairs_[k];
-    const Vec3& n = tri_n_[c.tri];  // references: see solve_rt
-    const double nn = dot(n, n);
-    if (!(nn > kMinArea2)) continue;
-    const Vec3& a = x[tri[3 * c.tri]];
-    const Vec3& xp = x[c.node];
-    const double dn = dot(xp - a, n);  // d |n|
-    if (dn * dn >= reach * reach * nn) continue;
-    double bary[3];
-    if (!barycentric(xp, a, x[tri[3 * c.tri + 1]], x[tri[3 * c.tri + 2]], n, nn, bary)) continue;
-    self_active_[n_self_active_++] = {c.node, c.tri, dn >= 0 ? 1.0 : -1.0};
-  }
+  n_self_active_ = layer_select(self_pairs_.data(), n_self_, tri.data(), x.data(), tri_n_.data(), reach,
+                                kBaryTolerance, kMinArea2, self_active_.data(), use_select_simd_);
   stats_.shape_contacts = shape_active_.size();
   stats_.self_pairs = n_self_active_;
 }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "collision_world.h"
+#include "layer_select.h"
 #include "shape_contacts.h"
 #include "sheet_params.h"
 #include "topology.h"
@@ -54,9 +55,11 @@ class ContactSolver {
                 bool with_self = true) noexcept;
 
   [[nodiscard]] const ContactStats& stats() const noexcept { return stats_; }
-  // Screens nodes without AVX2 even when the CPU has it (tests compare the two).
+  // Screens nodes without AVX2 and selects without AVX-512 even when the CPU has them (tests
+  // compare the two).
   void force_scalar(bool on) noexcept {
     use_simd_ = has_simd_ && !on;
+    use_select_simd_ = has_select_simd_ && !on;
     shape_active_.force_scalar(on);
   }
 
@@ -66,10 +69,7 @@ class ContactSolver {
     Vec3 normal;
     double offset;  // surface: dot(normal, y) = offset
   };
-  struct SelfPair {
-    std::int32_t node, tri;
-    double side;  // +1 / -1: which side of the triangle the node stays on
-  };
+  using SelfPair = LayerPair;
 
   void detect_self_rt(std::span<const Vec3> x, double margin_mm, double lateral_mm) noexcept;
 
@@ -77,6 +77,7 @@ class ContactSolver {
   double half_thickness_ = 0.5, thickness_ = 1.0, friction_ = 0.5;
   bool self_enabled_ = true;
   bool has_simd_ = false, use_simd_ = false;  // AVX2 node screening (runtime check)
+  bool has_select_simd_ = false, use_select_simd_ = false;  // AVX-512 select (layer_select.h)
   std::vector<ShapePair> shape_pairs_;
   int n_shape_ = 0;
   std::vector<SelfPair> self_pairs_;

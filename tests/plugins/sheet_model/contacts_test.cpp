@@ -77,7 +77,7 @@ TEST_CASE("self-collision candidates match a brute-force reference, with and wit
   CHECK(checked > 5);  // folded layers do come close
 }
 
-TEST_CASE("candidates kept from a wider detection select what a fresh detection finds after a move") {
+TEST_CASE("candidates kept from a wider detection select what a fresh detection finds after a move (8 at a time and one by one)") {
   // Detection with the margin plus a skin (and the skin beside each triangle), then every
   // node moved by up to half the skin: select_rt must give exactly the pairs a fresh
   // detection with the frame's margin gives (a pair missed by the wide detection fails it).
@@ -99,17 +99,23 @@ TEST_CASE("candidates kept from a wider detection select what a fresh detection 
         if (norm(d) > 1.0) d = normalized(d);
         moved[i] = x[i] + (0.5 * kSkin) * d;
       }
-      ContactSolver kept, fresh;
+      ContactSolver kept, fresh, one_by_one;
       kept.configure(topo, gp, sp);
       fresh.configure(topo, gp, sp);
+      one_by_one.configure(topo, gp, sp);
+      one_by_one.force_scalar(true);  // no AVX2 screening, no AVX-512 select
       kept.detect_rt(x, nullptr, kMargin + kSkin, kSkin);
+      one_by_one.detect_rt(x, nullptr, kMargin + kSkin, kSkin);
       REQUIRE(kept.stats().dropped == 0);
       CHECK(kept.stats().self_candidates >= kept.stats().self_pairs);
+      CHECK(one_by_one.stats().self_candidates == kept.stats().self_candidates);
       kept.select_rt(moved, kMargin);
+      one_by_one.select_rt(moved, kMargin);
       fresh.detect_rt(moved, nullptr, kMargin);
       const int ref = reference_pairs(topo, gp, moved, kMargin);
       CHECK(fresh.stats().self_pairs == ref);
       CHECK(kept.stats().self_pairs == ref);
+      CHECK(one_by_one.stats().self_pairs == ref);
       checked += ref > 0;
     }
   }
