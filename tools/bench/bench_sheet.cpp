@@ -5,9 +5,12 @@
 // Tracking: 35 markers x 5 key-points observed at 15 Hz with 0.3 mm noise (fixed seed);
 // runs: all key-points; 30 % dropped per vision frame plus the flap (v < h/2) hidden for
 // 1 s. Error: mean distance of every node to the analytic fold, every frame.
-// Time: ours and Bullet each track the fold --repeats times (default 5) from a fresh start,
-// taking turns; each one's figure is the median of its runs (a process's first run pays for a
-// cold CPU and caches). Every run is printed.
+// Time: ours and Bullet take --repeats turns each (default 5), alternating. In a turn an
+// engine tracks the fold from a fresh start again and again until it has stepped for at least
+// --turn-s seconds (default 0.5: one Bullet run, ~10 of ours), so both are timed over windows
+// of the same length on this shared machine; a turn's figure is its step time over its frames,
+// and each engine's figure is the median of its turns (a process's first turn pays for a cold
+// CPU and caches). Every turn is printed.
 #include <BulletSoftBody/btDefaultSoftBodySolver.h>
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -49,6 +52,7 @@ struct Engine {
 
 struct TrackResult {
   double mean_err_mm = 0, end_err_mm = 0, max_jump_mm = 0, us_per_frame = 0;
+  int frames = 0;
 };
 
 TrackResult track(Engine& e, const FoldScript& truth, const std::vector<Vec2>& kps, bool dropout, int node_count) {
@@ -92,6 +96,7 @@ TrackResult track(Engine& e, const FoldScript& truth, const std::vector<Vec2>& k
   }
   r.mean_err_mm = err_sum / frames;
   r.us_per_frame = time_sum / frames;
+  r.frames = frames;
   return r;
 }
 
@@ -229,16 +234,20 @@ double median_of(std::vector<double> v) {
 int run_sheet(int argc, char** argv) {
   SheetParams p;
   int repeats = 5;
+  double turn_s = 0.5;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--repeats" && i + 1 < argc) {
       repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--turn-s" && i + 1 < argc) {
+      turn_s = std::max(0.0, std::atof(argv[++i]));
     } else if (a == "--substeps" && i + 1 < argc) {
       p.solver.substeps = std::atoi(argv[++i]);
     } else if (a == "--no-self-collision") {
       p.solver.self_collision = false;
     } else {
-      std::fprintf(stderr, "usage: crease-bench sheet [--repeats N] [--substeps N] [--no-self-collision]\n");
+      std::fprintf(stderr,
+                   "usage: crease-bench sheet [--repeats N] [--turn-s S] [--substeps N] [--no-self-collision]\n");
       return 2;
     }
   }
@@ -249,16 +258,26 @@ int run_sheet(int argc, char** argv) {
   Ours ours(p);  // for the counts
   TrackResult o, b;
   std::vector<double> ours_us, bullet_us;
+  std::vector<int> ours_runs, bullet_runs;
+  // One turn: fresh runs until turn_s of stepping; returns us per frame over the turn.
+  auto turn = [&](auto make, TrackResult& first, std::vector<int>& runs) {
+    double us = 0, stepped_s = 0;
+    int n = 0;
+    do {
+      const auto sheet = make();
+      auto e = sheet->engine();
+      const TrackResult t = track(e, truth, kps, false, nodes);
+      if (n == 0) first = t;  // tracking is deterministic: every run gives the same errors
+      us += t.us_per_frame;  // every run has the same frames: the mean of the runs' means
+      stepped_s += t.us_per_frame * t.frames * 1e-6;
+      ++n;
+    } while (stepped_s < turn_s);
+    runs.push_back(n);
+    return us / n;
+  };
   for (int r = 0; r < repeats; ++r) {
-    Ours x(p);
-    auto e = x.engine();
-    const TrackResult t = track(e, truth, kps, false, nodes);
-    BulletSheet y(p);
-    auto f = y.engine();
-    const TrackResult u = track(f, truth, kps, false, nodes);
-    if (r == 0) o = t, b = u;  // tracking is deterministic: every run gives the same errors
-    ours_us.push_back(t.us_per_frame);
-    bullet_us.push_back(u.us_per_frame);
+    ours_us.push_back(turn([&] { return std::make_unique<Ours>(p); }, o, ours_runs));
+    bullet_us.push_back(turn([&] { return std::make_unique<BulletSheet>(p); }, b, bullet_runs));
   }
   o.us_per_frame = median_of(ours_us);
   b.us_per_frame = median_of(bullet_us);
@@ -277,13 +296,13 @@ int run_sheet(int argc, char** argv) {
               p.grid.nodes_u, p.grid.nodes_v, ours.s->link_count(), ours.s->topology().structural_count,
               ours.s->topology().bending_count, p.solver.substeps);
   std::printf("half fold 0->175 deg in 5 s, hold 3 s; %zu key-points at 15 Hz, 0.3 mm noise\n", kps.size());
-  auto runs = [](const char* name, const std::vector<double>& us) {
-    std::printf("%s us/frame per run:", name);
-    for (double u : us) std::printf(" %.1f", u);
-    std::printf(" (median %.1f)\n", median_of(us));
+  auto runs = [](const char* name, const std::vector<double>& us, const std::vector<int>& n) {
+    std::printf("%s us/frame per turn (runs):", name);
+    for (std::size_t k = 0; k < us.size(); ++k) std::printf(" %.1f (%d)", us[k], n[k]);
+    std::printf(", median %.1f\n", median_of(us));
   };
-  runs("ours  ", ours_us);
-  runs("bullet", bullet_us);
+  runs("ours  ", ours_us, ours_runs);
+  runs("bullet", bullet_us, bullet_runs);
   std::printf("%-28s %12s %10s %10s %14s %12s\n", "engine", "us/frame", "err_mm", "end_mm", "dropout_err_mm", "max_jump_mm");
   auto row = [](const char* name, const TrackResult& a, const TrackResult& d) {
     std::printf("%-28s %12.1f %10.2f %10.2f %14.2f %12.2f\n", name, a.us_per_frame, a.mean_err_mm, a.end_err_mm,
