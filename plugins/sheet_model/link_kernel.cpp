@@ -27,6 +27,18 @@ struct Arrays {
   const float* wb;
 };
 
+// A batch's arrays from its lane 0 on, and its loop bounds, held in locals by the vector
+// paths: their stores may alias anything, so fields read through references would be loaded
+// again after every store.
+struct BatchView {
+  int step, lanes, d;
+  float *x, *y, *z;
+  const float *rest, *wa, *wb;
+  BatchView(const LinkKernel::Batch& bt, const Arrays& r) noexcept
+      : step(bt.step), lanes(bt.lanes), d(bt.d), x(r.x + bt.a0), y(r.y + bt.a0), z(r.z + bt.a0),
+        rest(r.rest + bt.data), wa(r.wa + bt.data), wb(r.wb + bt.data) {}
+};
+
 // x_a += w_a (|d| - l) / (w_a + w_b + alpha/dt_s^2) d/|d|; x_b likewise with -.
 void project_lane(const LinkKernel::Batch& bt, const Arrays& r, int l) noexcept {
   const int q = bt.data + l;
@@ -58,23 +70,15 @@ void project_batch_scalar(const LinkKernel::Batch& bt, const Arrays& r) noexcept
 __attribute__((target("avx2,fma"))) void project_batch_avx2(const LinkKernel::Batch& bt, const Arrays& r) noexcept {
   const __m256 one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f), three_halves = _mm256_set1_ps(1.5f);
   const __m256 tiny = _mm256_set1_ps(kMinLen2);
-  // Locals: the vector stores may alias anything, so fields read in the loop would be
-  // loaded again after every store.
-  const int step = bt.step, lanes = bt.lanes, d = bt.d;
-  float* const x = r.x + bt.a0;
-  float* const y = r.y + bt.a0;
-  float* const z = r.z + bt.a0;
-  const float* const rest = r.rest + bt.data;
-  const float* const wa = r.wa + bt.data;
-  const float* const wb = r.wb + bt.data;
-  for (int first = 0; first < step; ++first) {
-    for (int l = first * kVec; l < lanes; l += kVec * step) {
-      float* xa = x + l;
-      float* ya = y + l;
-      float* za = z + l;
-      float* xb = xa + d;
-      float* yb = ya + d;
-      float* zb = za + d;
+  const BatchView v(bt, r);
+  for (int first = 0; first < v.step; ++first) {
+    for (int l = first * kVec; l < v.lanes; l += kVec * v.step) {
+      float* xa = v.x + l;
+      float* ya = v.y + l;
+      float* za = v.z + l;
+      float* xb = xa + v.d;
+      float* yb = ya + v.d;
+      float* zb = za + v.d;
       __m256 ax = _mm256_loadu_ps(xa), ay = _mm256_loadu_ps(ya), az = _mm256_loadu_ps(za);
       __m256 bx = _mm256_loadu_ps(xb), by = _mm256_loadu_ps(yb), bz = _mm256_loadu_ps(zb);
       const __m256 dx = _mm256_sub_ps(bx, ax), dy = _mm256_sub_ps(by, ay), dz = _mm256_sub_ps(bz, az);
@@ -84,9 +88,9 @@ __attribute__((target("avx2,fma"))) void project_batch_avx2(const LinkKernel::Ba
       __m256 inv = _mm256_rsqrt_ps(l2);
       // Newton: inv *= 1.5 - 0.5 l2 inv^2
       inv = _mm256_mul_ps(inv, _mm256_fnmadd_ps(_mm256_mul_ps(half, l2), _mm256_mul_ps(inv, inv), three_halves));
-      const __m256 s = _mm256_and_ps(ok, _mm256_fnmadd_ps(_mm256_loadu_ps(rest + l), inv, one));
-      const __m256 fa = _mm256_mul_ps(_mm256_loadu_ps(wa + l), s);
-      const __m256 fb = _mm256_mul_ps(_mm256_loadu_ps(wb + l), s);
+      const __m256 s = _mm256_and_ps(ok, _mm256_fnmadd_ps(_mm256_loadu_ps(v.rest + l), inv, one));
+      const __m256 fa = _mm256_mul_ps(_mm256_loadu_ps(v.wa + l), s);
+      const __m256 fb = _mm256_mul_ps(_mm256_loadu_ps(v.wb + l), s);
       ax = _mm256_fmadd_ps(fa, dx, ax);
       ay = _mm256_fmadd_ps(fa, dy, ay);
       az = _mm256_fmadd_ps(fa, dz, az);
@@ -109,23 +113,15 @@ __attribute__((target("avx2,fma"))) void project_batch_avx2(const LinkKernel::Ba
 __attribute__((target("avx512f"))) void project_batch_avx512(const LinkKernel::Batch& bt, const Arrays& r) noexcept {
   const __m512 one = _mm512_set1_ps(1.0f);
   const __m512 tiny = _mm512_set1_ps(kMinLen2);
-  // Locals: the vector stores may alias anything, so fields read in the loop would be
-  // loaded again after every store.
-  const int step = bt.step, lanes = bt.lanes, d = bt.d;
-  float* const x = r.x + bt.a0;
-  float* const y = r.y + bt.a0;
-  float* const z = r.z + bt.a0;
-  const float* const rest = r.rest + bt.data;
-  const float* const wa = r.wa + bt.data;
-  const float* const wb = r.wb + bt.data;
-  for (int first = 0; first < step; ++first) {
-    for (int l = first * kVec16; l < lanes; l += kVec16 * step) {
-      float* xa = x + l;
-      float* ya = y + l;
-      float* za = z + l;
-      float* xb = xa + d;
-      float* yb = ya + d;
-      float* zb = za + d;
+  const BatchView v(bt, r);
+  for (int first = 0; first < v.step; ++first) {
+    for (int l = first * kVec16; l < v.lanes; l += kVec16 * v.step) {
+      float* xa = v.x + l;
+      float* ya = v.y + l;
+      float* za = v.z + l;
+      float* xb = xa + v.d;
+      float* yb = ya + v.d;
+      float* zb = za + v.d;
       __m512 ax = _mm512_loadu_ps(xa), ay = _mm512_loadu_ps(ya), az = _mm512_loadu_ps(za);
       __m512 bx = _mm512_loadu_ps(xb), by = _mm512_loadu_ps(yb), bz = _mm512_loadu_ps(zb);
       const __m512 dx = _mm512_sub_ps(bx, ax), dy = _mm512_sub_ps(by, ay), dz = _mm512_sub_ps(bz, az);
@@ -134,9 +130,9 @@ __attribute__((target("avx512f"))) void project_batch_avx512(const LinkKernel::B
       // maskz forms: the plain ones use _mm512_undefined_ps, which GCC 12 warns about.
       const __m512 l2 = _mm512_maskz_max_ps(0xFFFF, len2, tiny);
       const __m512 inv = _mm512_maskz_rsqrt14_ps(0xFFFF, l2);
-      const __m512 s = _mm512_maskz_mov_ps(ok, _mm512_fnmadd_ps(_mm512_loadu_ps(rest + l), inv, one));
-      const __m512 fa = _mm512_mul_ps(_mm512_loadu_ps(wa + l), s);
-      const __m512 fb = _mm512_mul_ps(_mm512_loadu_ps(wb + l), s);
+      const __m512 s = _mm512_maskz_mov_ps(ok, _mm512_fnmadd_ps(_mm512_loadu_ps(v.rest + l), inv, one));
+      const __m512 fa = _mm512_mul_ps(_mm512_loadu_ps(v.wa + l), s);
+      const __m512 fb = _mm512_mul_ps(_mm512_loadu_ps(v.wb + l), s);
       _mm512_storeu_ps(xa, _mm512_fmadd_ps(fa, dx, ax));
       _mm512_storeu_ps(ya, _mm512_fmadd_ps(fa, dy, ay));
       _mm512_storeu_ps(za, _mm512_fmadd_ps(fa, dz, az));
