@@ -142,7 +142,10 @@ void ContactSolver::detect_rt(std::span<const Vec3> x, const CollisionWorld* wor
   n_self_ = 0;
   if (self_enabled_) detect_self_rt(x, margin_mm, std::max(0.0, lateral_mm));
   shape_active_.clear();
-  for (int k = 0; k < n_shape_; ++k) shape_active_.push(shape_pairs_[k].node, shape_pairs_[k].normal, shape_pairs_[k].offset);
+  for (int k = 0; k < n_shape_; ++k) {
+    const ShapePair& c = shape_pairs_[k];
+    shape_active_.push(c.node, c.normal, c.offset);
+  }
   std::copy_n(self_pairs_.begin(), n_self_, self_active_.begin());
   n_self_active_ = n_self_;
   ++stamp_;

@@ -65,6 +65,14 @@ void project_batch_scalar(const LinkKernel::Batch& bt, const Arrays& r) noexcept
       for (int e = 0; e < bt.width; ++e) project_lane(bt, r, l + e);
 }
 
+// dst[r * dst_stride + c] = src[c * src_stride + r] for r < rows, c < cols; nothing else of
+// dst is written (transpose_avx512 likewise, 16 at a time).
+void transpose_scalar(const float* src, int src_stride, float* dst, int dst_stride, int rows, int cols) noexcept {
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      dst[static_cast<std::ptrdiff_t>(r) * dst_stride + c] = src[static_cast<std::ptrdiff_t>(c) * src_stride + r];
+}
+
 #ifdef CREASE_SHEET_X86
 // 8 lanes at once (bt.width 8: bt.d >= 8). 1/|d| from rsqrt plus one Newton step (~23 bits).
 __attribute__((target("avx2,fma"))) void project_batch_avx2(const LinkKernel::Batch& bt, const Arrays& r) noexcept {
@@ -228,7 +236,9 @@ bool cpu_has_avx512f() noexcept {
 }
 #else
 void row_to_floats_avx512(const double*, int, float* const*) noexcept {}
-void transpose_avx512(const float*, int, float*, int, int, int) noexcept {}
+void transpose_avx512(const float* src, int ss, float* dst, int ds, int rows, int cols) noexcept {
+  transpose_scalar(src, ss, dst, ds, rows, cols);
+}
 void row_add_moves_avx512(double*, int, const float* const*) noexcept {}
 void project_batch_avx2(const LinkKernel::Batch& bt, const Arrays& r) noexcept { project_batch_scalar(bt, r); }
 void project_batch_avx512(const LinkKernel::Batch& bt, const Arrays& r) noexcept { project_batch_scalar(bt, r); }
@@ -414,39 +424,13 @@ void LinkKernel::project_rt(std::span<Vec3> x) noexcept {
     std::fill(l1.px.begin(), l1.px.end(), 0.0f);
     std::fill(l1.py.begin(), l1.py.end(), 0.0f);
     std::fill(l1.pz.begin(), l1.pz.end(), 0.0f);
-    if (has_avx512_) {  // layout 1 row i is layout 0 column i
-      for (int c = 0; c < 3; ++c) {
-        const float* src = c == 0 ? l0.px.data() : c == 1 ? l0.py.data() : l0.pz.data();
-        float* dst = c == 0 ? l1.px.data() : c == 1 ? l1.py.data() : l1.pz.data();
-        transpose_avx512(src, l0.stride, dst, l1.stride, w_, h_);
-      }
-    } else {
-      for (int j = 0; j < h_; ++j) {
-        for (int i = 0; i < w_; ++i) {
-          const int p = l0.index(i, j), q = l1.index(i, j);
-          l1.px[q] = l0.px[p];
-          l1.py[q] = l0.py[p];
-          l1.pz[q] = l0.pz[p];
-        }
-      }
-    }
+    // Layout 1 row i is layout 0 column i; and back after its batches.
+    const auto transpose = has_avx512_ ? transpose_avx512 : transpose_scalar;
+    float* const c0[3] = {l0.px.data(), l0.py.data(), l0.pz.data()};
+    float* const c1[3] = {l1.px.data(), l1.py.data(), l1.pz.data()};
+    for (int c = 0; c < 3; ++c) transpose(c0[c], l0.stride, c1[c], l1.stride, w_, h_);
     run(l1);
-    if (has_avx512_) {  // back to layout 0
-      for (int c = 0; c < 3; ++c) {
-        const float* src = c == 0 ? l1.px.data() : c == 1 ? l1.py.data() : l1.pz.data();
-        float* dst = c == 0 ? l0.px.data() : c == 1 ? l0.py.data() : l0.pz.data();
-        transpose_avx512(src, l1.stride, dst, l0.stride, h_, w_);
-      }
-    } else {
-      for (int i = 0; i < w_; ++i) {  // back to layout 0
-        for (int j = 0; j < h_; ++j) {
-          const int p = l0.index(i, j), q = l1.index(i, j);
-          l0.px[p] = l1.px[q];
-          l0.py[p] = l1.py[q];
-          l0.pz[p] = l1.pz[q];
-        }
-      }
-    }
+    for (int c = 0; c < 3; ++c) transpose(c1[c], l1.stride, c0[c], l0.stride, h_, w_);
   }
   if (has_avx512_) {
     for (int j = 0; j < h_; ++j) {
