@@ -16,9 +16,11 @@ using crease::drivers::testing::Ticker;
 
 TEST_CASE("host and simulated hand: commands round-trip, silence -> safe state -> recovery") {
   crease::drivers::testing::ScopedFifo fifo;
-  // Without SCHED_FIFO on a loaded machine a device thread can miss its 1 ms deadline now and
-  // then; those cycles are reported (degraded, failed commands), never hidden.
-  const int min_ok = fifo.active() ? 300 : 150;
+  // A device thread can miss its 1 ms deadline now and then on a loaded machine (also under
+  // SCHED_FIFO); those cycles are reported (degraded, failed commands), never hidden, and their
+  // share is a figure of the machine (crease-bench bus). Only a broken link is healthy in fewer
+  // than half of its 400 cycles.
+  const int min_ok = 200;
   const std::string name = crease::drivers::testing::unique_bus("hand");
   MockCanBroker broker({name, 1'000'000, 5'000'000, false});
   MockCanBus host_bus({name, 100, 1'000'000, 5'000'000});
