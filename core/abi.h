@@ -18,7 +18,8 @@
 extern "C" {
 #endif
 
-#define CREASE_PLUGIN_ABI_VERSION 1u
+/* 2: the optional write phase (crease_plugin_descriptor.write). */
+#define CREASE_PLUGIN_ABI_VERSION 2u
 #define CREASE_PLUGIN_ENTRY_SYMBOL "crease_plugin_entry"
 #define CREASE_EXPORT __attribute__((visibility("default")))
 
@@ -46,7 +47,8 @@ typedef struct crease_plugin_descriptor {
   int32_t (*configure)(void* self, void* ctx, char* error, size_t error_size);
   /* non-RT, required. Called before the instance is scheduled. Must not write outputs. */
   int32_t (*activate)(void* self, char* error, size_t error_size);
-  /* RT, required. Once per cycle of the instance's loop. */
+  /* RT, required. Once per cycle of the instance's loop: read inputs (a driver: the bus), compute,
+   * write outputs. */
   int32_t (*update)(void* self, const crease_cycle* cycle);
   /* non-RT, required. Called after the instance left the schedule. */
   int32_t (*deactivate)(void* self);
@@ -60,6 +62,10 @@ typedef struct crease_plugin_descriptor {
   int32_t (*load_state)(void* self, const void* buf, size_t len);
   /* non-RT, required. Validates a new value for a tunable parameter; 0 = accept. */
   int32_t (*validate_param)(void* self, const char* key, double value, char* error, size_t error_size);
+  /* RT, optional (NULL: no write phase). Once per cycle, after every instance of the loop ran
+   * update: sends what this cycle computed (a driver: the commands other plugins wrote in this
+   * cycle's update), as ros2_control's write() after update(). Return codes as update. */
+  int32_t (*write)(void* self, const crease_cycle* cycle);
 } crease_plugin_descriptor;
 
 typedef const crease_plugin_descriptor* (*crease_plugin_entry_fn)(void);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <thread>
 
+#include "core/assert.h"
 #include "rt/clock.h"
 
 namespace crease {
@@ -35,46 +36,50 @@ Loop::Loop(LoopSpec spec)
       events_(sizeof(LoopEvent), 1024),
       log_(256),
       thread_(thread_settings(spec_), &Loop::body, this) {
-  current_.store(new Schedule{}, std::memory_order_release);
+  schedules_.push_back(std::make_unique<Schedule>());
+  current_.store(schedules_.back().get(), std::memory_order_release);
 }
 
-Loop::~Loop() {
-  thread_.stop();
-  delete pending_.exchange(nullptr);
-  delete current_.exchange(nullptr);
-  delete replaced_;
-}
+Loop::~Loop() { thread_.stop(); }  // schedules_ frees every schedule
 
 std::vector<rt::SetupStep> Loop::start() { return thread_.start(); }
-void Loop::stop() { thread_.stop(); }
+void Loop::stop() {
+  thread_.stop();
+  // A publication the thread did not get to: adopted here, so nothing stays pending.
+  if (Schedule* next = pending_.exchange(nullptr, std::memory_order_acq_rel)) {
+    adopt_rt(next, rt::CycleClock{0, rt::now_ns(), rt::now_ns(), period_ns()});
+  }
+  reclaim();
+}
 
 void Loop::body(void* self, const rt::CycleClock& clock) noexcept { static_cast<Loop*>(self)->run_cycle_rt(clock); }
 
-std::unique_ptr<Schedule> Loop::publish(std::unique_ptr<Schedule> next, std::chrono::milliseconds timeout) {
-  Schedule* raw = next.release();
-  raw->generation = adopted_.load(std::memory_order_acquire) + 1;
+Loop::Publication Loop::publish(std::unique_ptr<Schedule> next, std::chrono::milliseconds timeout) {
+  CREASE_DEMAND(!adoption_pending(), "a schedule published while another is pending");
+  next->generation = ++published_;
+  Schedule* raw = next.get();
+  schedules_.push_back(std::move(next));
   if (!thread_.running()) {
     const rt::CycleClock clock{0, rt::now_ns(), rt::now_ns(), period_ns()};
-    Schedule* old = current_.load(std::memory_order_acquire);
     adopt_rt(raw, clock);  // no loop thread: the caller is the only one touching the schedule
-    return std::unique_ptr<Schedule>(old);
+    reclaim();
+    return {raw->generation, true};
   }
-  Schedule* old = current_.load(std::memory_order_acquire);
   pending_.store(raw, std::memory_order_release);
   const auto until = std::chrono::steady_clock::now() + timeout;
   while (adopted_.load(std::memory_order_acquire) < raw->generation) {
-    if (std::chrono::steady_clock::now() > until) {
-      replaced_ = old;  // reclaim_adopted() hands it back once the loop moved on
-      return nullptr;
-    }
+    if (std::chrono::steady_clock::now() >= until) return {raw->generation, false};
     std::this_thread::sleep_for(std::chrono::microseconds(100));
   }
-  return std::unique_ptr<Schedule>(old);
+  reclaim();
+  return {raw->generation, true};
 }
 
-std::unique_ptr<Schedule> Loop::reclaim_adopted() {
-  if (replaced_ == nullptr || pending_.load(std::memory_order_acquire) != nullptr) return nullptr;
-  return std::unique_ptr<Schedule>(std::exchange(replaced_, nullptr));
+std::uint64_t Loop::reclaim() {
+  const std::uint64_t adopted = adopted_.load(std::memory_order_acquire);
+  // The loop runs the schedule of generation `adopted`; older ones it has left for good.
+  std::erase_if(schedules_, [adopted](const std::unique_ptr<Schedule>& s) { return s->generation < adopted; });
+  return adopted;
 }
 
 void Loop::adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept {
@@ -90,34 +95,62 @@ void Loop::adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept {
   adopted_.store(next->generation, std::memory_order_release);
 }
 
+std::int64_t Loop::run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle) noexcept {
+  const std::int64_t t0 = rt::now_ns();
+  Status status = Status::ok;
+  const FaultKind fault = write_phase ? inst.write_rt(cycle, status) : inst.update_rt(cycle, status);
+  const std::int64_t t1 = rt::now_ns();
+  PluginStats& stats = inst.stats();
+  if (status == Status::degraded) stats.degraded.fetch_add(1, std::memory_order_relaxed);
+  if (fault != FaultKind::none) {
+    stats.faults.fetch_add(1, std::memory_order_relaxed);
+    push_event_rt(make_event(LoopEvent::Type::fault, fault, inst.last_code.load(std::memory_order_relaxed), cycle.index,
+                             t1, inst));
+    log_.try_log(rt::LogLevel::error, inst.name().c_str(), "plugin stopped by the firewall: its outputs are safe", t1);
+  }
+  return t1 - t0;
+}
+
+void Loop::record_execution_rt(PluginInstance& inst, std::int64_t ns, std::uint64_t cycle, std::int64_t t0) noexcept {
+  PluginStats& stats = inst.stats();
+  stats.execution.record(static_cast<std::uint64_t>(ns), cycle, t0);
+  stats.updates.store(stats.updates.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
 void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
   if (Schedule* next = pending_.exchange(nullptr, std::memory_order_acq_rel)) adopt_rt(next, clock);
   const Schedule* s = current_.load(std::memory_order_relaxed);  // only this thread stores it while running
   const crease_cycle cycle{clock.cycle, clock.deadline_ns, clock.period_ns, clock.wake_ns};
+  bool any_write = false;
+  // Phase 1: update, in run order.
   for (const Schedule::Entry& e : s->entries) {
     PluginInstance& inst = *e.instance;
+    e.update_ns = -1;  // no write phase this cycle unless its update ran and went on
     const RunState st = inst.state.load(std::memory_order_acquire);
     if (st == RunState::active) {
       inst.apply_param_changes_rt();
       const std::int64_t t0 = rt::now_ns();
-      Status status = Status::ok;
-      const FaultKind fault = inst.update_rt(cycle, status);
-      const std::int64_t t1 = rt::now_ns();
-      PluginStats& stats = inst.stats();
-      stats.execution.record(static_cast<std::uint64_t>(t1 - t0), clock.cycle, t0);
-      stats.updates.store(stats.updates.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-      if (status == Status::degraded) stats.degraded.fetch_add(1, std::memory_order_relaxed);
-      if (fault != FaultKind::none) {
-        stats.faults.fetch_add(1, std::memory_order_relaxed);
-        push_event_rt(make_event(LoopEvent::Type::fault, fault, inst.last_code.load(std::memory_order_relaxed),
-                                 clock.cycle, t1, inst));
-        log_.try_log(rt::LogLevel::error, inst.name().c_str(), "plugin stopped by the firewall: its outputs are safe", t1);
+      const std::int64_t ns = run_hook_rt(inst, false, cycle);
+      // An instance with a write phase is timed over both hooks (recorded after its write).
+      if (inst.has_write() && inst.state.load(std::memory_order_relaxed) == RunState::active) {
+        e.update_ns = ns;
+        any_write = true;
+      } else {
+        record_execution_rt(inst, ns, clock.cycle, t0);
       }
     } else if (st == RunState::deactivate_requested) {
       inst.drive_safe_outputs_rt(cycle.time_ns);
       inst.state.store(RunState::inactive, std::memory_order_release);
       push_event_rt(make_event(LoopEvent::Type::deactivated, FaultKind::none, 0, clock.cycle, clock.wake_ns, inst));
     }
+  }
+  if (!any_write) return;
+  // Phase 2: write, in run order, for the instances whose update ran (and did not fault) above.
+  for (const Schedule::Entry& e : s->entries) {
+    if (e.update_ns < 0) continue;
+    PluginInstance& inst = *e.instance;
+    const std::int64_t t0 = rt::now_ns();
+    record_execution_rt(inst, e.update_ns + run_hook_rt(inst, true, cycle), clock.cycle, t0);
   }
 }
 

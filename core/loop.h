@@ -5,11 +5,17 @@
 // adopts it, carries state from replaced instances to their successors (save_state ->
 // load_state into a preallocated buffer) and acknowledges by publishing the schedule's
 // generation. Only then may the host free the old schedule and what it alone referenced
-// (ros2_control's RTControllerListWrapper pattern, with atomics and stated orders).
+// (ros2_control's RTControllerListWrapper pattern, with atomics and stated orders). Each
+// publication has its own generation: what a schedule of generation g replaced may be freed
+// once this loop's adopted_generation() >= g, whatever other loops do.
 //
-// The firewall: an update that returns fault, throws, returns an unknown code or writes a
-// non-finite output stops that instance (outputs driven safe, state faulted) and is reported
-// as an event; the loop keeps its timing and runs the others.
+// A cycle has two phases: every active instance's update in run order (read inputs, compute,
+// write outputs), then the write hook of those that have one, in run order (a driver sends the
+// command a controller computed in this cycle's update: sensing to command in one cycle).
+//
+// The firewall: an update or write that returns fault, throws, returns an unknown code or
+// writes a non-finite output stops that instance (outputs driven safe, state faulted) and is
+// reported as an event; the loop keeps its timing and runs the others.
 #pragma once
 
 #include <atomic>
@@ -37,6 +43,7 @@ struct Schedule {
   struct Entry {
     PluginInstance* instance = nullptr;
     PluginInstance* takes_state_from = nullptr;  // set for the new version in a hot-swap
+    mutable std::int64_t update_ns = 0;          // loop thread only: this cycle's update time
   };
   std::vector<Entry> entries;  // in run order
   std::uint64_t generation = 0;
@@ -67,13 +74,21 @@ class Loop {
   void stop();
   [[nodiscard]] bool running() const noexcept { return thread_.running(); }
 
-  // Non-RT, one caller at a time. Publishes `next`. When the loop runs, waits (up to `timeout`)
-  // for the loop thread to adopt it; when it does not run, adopts it here. Returns the previous
-  // schedule once it is no longer used, or nullptr if the loop did not adopt in time (it
-  // will: call reclaim_adopted() later).
-  std::unique_ptr<Schedule> publish(std::unique_ptr<Schedule> next, std::chrono::milliseconds timeout);
-  // The schedule replaced by a late adoption, once adopted (else nullptr).
-  std::unique_ptr<Schedule> reclaim_adopted();
+  struct Publication {
+    std::uint64_t generation = 0;  // of the published schedule
+    bool adopted = false;          // the loop adopted it within the timeout
+  };
+  // Non-RT, one caller at a time, and only while no publication is pending (adoption_pending()
+  // false; a bug otherwise). Publishes `next`. When the loop runs, waits (up to `timeout`) for
+  // the loop thread to adopt it; when it does not run, adopts it here. Schedules the loop has
+  // moved past are freed here and by reclaim().
+  Publication publish(std::unique_ptr<Schedule> next, std::chrono::milliseconds timeout);
+  // Non-RT: frees the schedules the loop has moved past; returns adopted_generation().
+  std::uint64_t reclaim();
+  // A publication the loop thread has not adopted yet (a late adoption).
+  [[nodiscard]] bool adoption_pending() const noexcept { return pending_.load(std::memory_order_acquire) != nullptr; }
+  // Generation of the schedule the loop runs (any thread).
+  [[nodiscard]] std::uint64_t adopted_generation() const noexcept { return adopted_.load(std::memory_order_acquire); }
   [[nodiscard]] const Schedule* schedule() const noexcept { return current_.load(std::memory_order_acquire); }
 
   // Non-RT: events from the loop thread.
@@ -93,12 +108,17 @@ class Loop {
   static void body(void* self, const rt::CycleClock& clock) noexcept;
   void adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept;
   void push_event_rt(const LoopEvent& e) noexcept { (void)events_.try_push(&e); }
+  // Runs one phase's hook of an active instance and accounts for it: degraded and fault counts,
+  // the firewall event. Returns the hook's duration (ns).
+  std::int64_t run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle) noexcept;
+  static void record_execution_rt(PluginInstance& inst, std::int64_t ns, std::uint64_t cycle, std::int64_t t0) noexcept;
 
   LoopSpec spec_;
-  std::atomic<Schedule*> current_{nullptr};   // owned; replaced only by adopt
-  std::atomic<Schedule*> pending_{nullptr};   // published by the host, taken by the loop
+  std::atomic<Schedule*> current_{nullptr};   // in schedules_; replaced only by adopt
+  std::atomic<Schedule*> pending_{nullptr};   // in schedules_; published by the host, taken by the loop
   std::atomic<std::uint64_t> adopted_{0};     // generation of the last adopted schedule
-  Schedule* replaced_ = nullptr;              // old schedule awaiting reclaim after a late adoption
+  std::vector<std::unique_ptr<Schedule>> schedules_;  // non-RT: every schedule not yet freed
+  std::uint64_t published_ = 0;               // non-RT: generation of the last publication
   std::unique_ptr<unsigned char[]> state_buf_;
   rt::QueueChannel events_;
   rt::RtLogQueue log_;

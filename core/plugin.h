@@ -19,6 +19,10 @@
 //   activate    non-RT  before the instance is scheduled; must not write outputs
 //   update      RT      every cycle: no allocation, lock, blocking call, exception or logging
 //                       (use log_rt); return ok / degraded / fault
+//   write       RT      optional: declare `crease::Status write(const crease::Cycle&)` (not a
+//                       virtual of Plugin) to get a write phase: called every cycle after every
+//                       instance of the loop ran update, so a driver reads its bus in update and
+//                       sends, in write, the command a controller computed in this same cycle
 //   deactivate  non-RT  after the instance left the schedule
 //   cleanup     non-RT  release what configure acquired
 //   save_state  RT-safe at a hot-swap boundary: copy the state the next version takes over
@@ -30,6 +34,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <concepts>
 #include <exception>
 #include <span>
 #include <string>
@@ -151,6 +156,13 @@ struct Adapter {
       return 3;
     }
   }
+  static std::int32_t write(void* self, const crease_cycle* cycle) noexcept {
+    try {
+      return static_cast<std::int32_t>(static_cast<P*>(self)->write(*cycle));
+    } catch (...) {
+      return 3;
+    }
+  }
   static std::int32_t deactivate(void* self) noexcept {
     try {
       static_cast<P*>(self)->deactivate();
@@ -187,6 +199,21 @@ struct Adapter {
   }
 };
 
+// A plugin has a write phase when it declares `Status write(const Cycle&)`.
+template <class P>
+concept HasWritePhase = requires(P& p, const Cycle& c) {
+  { p.write(c) } -> std::same_as<Status>;
+};
+
+template <class P>
+constexpr auto write_hook() noexcept -> std::int32_t (*)(void*, const crease_cycle*) {
+  if constexpr (HasWritePhase<P>) {
+    return &Adapter<P>::write;
+  } else {
+    return nullptr;
+  }
+}
+
 template <class P>
 const crease_plugin_descriptor* descriptor_for(const char* name, const char* version) noexcept {
   static const crease_plugin_descriptor d{
@@ -196,7 +223,8 @@ const crease_plugin_descriptor* descriptor_for(const char* name, const char* ver
       &Adapter<P>::configure,     &Adapter<P>::activate,
       &Adapter<P>::update,        &Adapter<P>::deactivate,
       &Adapter<P>::cleanup,       &Adapter<P>::save_state,
-      &Adapter<P>::load_state,    &Adapter<P>::validate_param};
+      &Adapter<P>::load_state,    &Adapter<P>::validate_param,
+      write_hook<P>()};
   return &d;
 }
 

@@ -29,7 +29,7 @@ PluginHost::~PluginHost() {
   stop();
   std::lock_guard lock(mu_);
   while (!managed_.empty()) managed_.pop_back();  // reverse order of loading
-  retired_.clear();
+  retired_.clear();  // the loops are stopped: nothing runs them
 }
 
 void PluginHost::set_event_sink(EventSink sink) {
@@ -79,7 +79,7 @@ Loop& PluginHost::add_loop(const LoopSpec& spec) {
   return loop;
 }
 
-bool PluginHost::reschedule(Loop& loop, PluginInstance* swap_to, PluginInstance* swap_from) {
+Loop::Publication PluginHost::reschedule(Loop& loop, PluginInstance* swap_to, PluginInstance* swap_from) {
   std::vector<const Managed*> mine;
   for (const Managed& m : managed_) {
     if (m.loop == &loop) mine.push_back(&m);
@@ -90,8 +90,37 @@ bool PluginHost::reschedule(Loop& loop, PluginInstance* swap_to, PluginInstance*
     PluginInstance* inst = m->instance.get();
     next->entries.push_back({inst, inst == swap_to ? swap_from : nullptr});
   }
-  // When adoption is late, Loop keeps the old schedule until reclaim_adopted() hands it back.
-  return loop.publish(std::move(next), kAdoptTimeout) != nullptr;
+  // When adoption is late, Loop keeps the old schedule until reclaim() sees it adopted.
+  return loop.publish(std::move(next), adopt_timeout_);
+}
+
+void PluginHost::require_no_pending(const Loop& loop, const std::string& what) const {
+  if (loop.adoption_pending())
+    throw Error(what + ": loop '" + loop.spec().name + "' has not adopted the previous change yet; retry");
+}
+
+void PluginHost::finish(PluginInstance& inst, bool unloaded) noexcept {
+  if (unloaded) inst.drive_safe_outputs(rt::now_ns());
+  inst.call_deactivate();
+}
+
+void PluginHost::retire(std::unique_ptr<PluginInstance> old, Loop& loop, Loop::Publication pub, bool unloaded) {
+  if (pub.adopted) {
+    finish(*old, unloaded);
+    old.reset();  // destroys the object, then dlcloses its library if nothing else holds it
+  } else {
+    retired_.push_back(Retired{std::move(old), &loop, pub.generation, unloaded});  // freed by poll()
+  }
+}
+
+void PluginHost::set_adopt_timeout(std::chrono::milliseconds t) {
+  std::lock_guard lock(mu_);
+  adopt_timeout_ = t;
+}
+
+std::size_t PluginHost::retired_count() const {
+  std::lock_guard lock(mu_);
+  return retired_.size();
 }
 
 void PluginHost::add_instance(const InstanceSpec& spec) {
@@ -99,6 +128,7 @@ void PluginHost::add_instance(const InstanceSpec& spec) {
   if (find(spec.name) != nullptr) throw ConfigError("instance '" + spec.name + "' is defined twice");
   Loop* loop = find_loop(spec.loop);
   if (loop == nullptr) throw ConfigError("instance '" + spec.name + "': no loop named '" + spec.loop + "'");
+  require_no_pending(*loop, "load '" + spec.name + "'");
   std::shared_ptr<PluginLibrary> lib = PluginLibrary::open(spec.library, dirs_);
   std::unique_ptr<PluginInstance> inst;
   try {
@@ -154,6 +184,7 @@ void PluginHost::swap(const std::string& name, const std::string& library, const
   std::lock_guard lock(mu_);
   Managed* m = find(name);
   if (m == nullptr) throw ConfigError("swap: no instance named '" + name + "'");
+  require_no_pending(*m->loop, "swap '" + name + "'");
   std::shared_ptr<PluginLibrary> lib = PluginLibrary::open(library, dirs_);
   const Params& p = params ? *params : m->spec.params;
   auto next = std::make_unique<PluginInstance>(name, lib, p, m->spec.ports, ports_, &m->loop->log_queue(),
@@ -165,12 +196,8 @@ void PluginHost::swap(const std::string& name, const std::string& library, const
   m->instance = std::move(next);
   m->spec.library = library;
   if (params) m->spec.params = *params;
-  if (reschedule(*m->loop, m->instance.get(), old.get())) {
-    old->call_deactivate();
-    old.reset();  // destroys the object, then dlcloses its library if nothing else holds it
-  } else {
-    retired_.push_back(std::move(old));  // not adopted yet: freed by poll() once it is
-  }
+  const Loop::Publication pub = reschedule(*m->loop, m->instance.get(), old.get());
+  retire(std::move(old), *m->loop, pub, false);
   drain_locked();  // records the swap event with its cycle
 }
 
@@ -179,17 +206,11 @@ void PluginHost::unload(const std::string& name) {
   auto it = std::find_if(managed_.begin(), managed_.end(), [&](const Managed& m) { return m.spec.name == name; });
   if (it == managed_.end()) throw ConfigError("unload: no instance named '" + name + "'");
   Loop* loop = it->loop;
+  require_no_pending(*loop, "unload '" + name + "'");
   std::unique_ptr<PluginInstance> inst = std::move(it->instance);
   const std::string loop_name = it->spec.loop;
   managed_.erase(it);
-  const bool adopted = reschedule(*loop);
-  if (adopted) {
-    inst->drive_safe_outputs(rt::now_ns());
-    inst->call_deactivate();
-    inst.reset();
-  } else {
-    retired_.push_back(std::move(inst));
-  }
+  retire(std::move(inst), *loop, reschedule(*loop), true);
   ports_.release(name);
   record({HostEvent::Type::unloaded, name, loop_name, {}});
 }
@@ -283,7 +304,13 @@ void PluginHost::drain_locked() {
         case rt::LogLevel::error: spdlog::error("{}", text); break;
       }
     }
-    if (l->reclaim_adopted() != nullptr) retired_.clear();
+    // Each retired instance waits for its own loop's acknowledgement, not any loop's.
+    const std::uint64_t adopted = l->reclaim();
+    std::erase_if(retired_, [&](Retired& r) {
+      if (r.loop != l.get() || r.generation > adopted) return false;
+      finish(*r.instance, r.unloaded);
+      return true;
+    });
   }
 }
 

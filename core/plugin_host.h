@@ -98,8 +98,13 @@ class PluginHost {
   [[nodiscard]] std::uint64_t fault_count() const;
   [[nodiscard]] const std::vector<std::filesystem::path>& plugin_dirs() const noexcept { return dirs_; }
 
-  // How long a schedule change waits for a loop to adopt it.
+  // How long a schedule change waits for a loop to adopt it (default kAdoptTimeout). A change
+  // not adopted in time goes on: what it replaced is freed by poll() once that loop adopted it,
+  // and further changes to that loop are refused (Error, "retry") until then.
   static constexpr std::chrono::milliseconds kAdoptTimeout{2000};
+  void set_adopt_timeout(std::chrono::milliseconds t);
+  // Replaced or unloaded instances still waiting for their loop to adopt the change.
+  [[nodiscard]] std::size_t retired_count() const;
 
  private:
   struct Managed {
@@ -110,9 +115,22 @@ class PluginHost {
   Managed* find(const std::string& name);
   const Managed* find(const std::string& name) const;
   Loop* find_loop(const std::string& name) const;
+  // An instance out of every schedule published since `generation`: freed (after its hooks)
+  // once its loop has adopted that generation.
+  struct Retired {
+    std::unique_ptr<PluginInstance> instance;
+    Loop* loop = nullptr;
+    std::uint64_t generation = 0;
+    bool unloaded = false;  // drive its outputs safe before deactivating (an unload)
+  };
   // Builds `loop`'s schedule from the managed instances, with `swap_from` carrying state into
-  // `swap_to`, and publishes it. False when the loop did not adopt it in time.
-  bool reschedule(Loop& loop, PluginInstance* swap_to = nullptr, PluginInstance* swap_from = nullptr);
+  // `swap_to`, and publishes it.
+  Loop::Publication reschedule(Loop& loop, PluginInstance* swap_to = nullptr, PluginInstance* swap_from = nullptr);
+  // Throws Error when `loop` has not adopted the previous change yet (`what`: the request).
+  void require_no_pending(const Loop& loop, const std::string& what) const;
+  // Frees `old` now if `pub` was adopted, else keeps it in retired_ until its loop adopted.
+  void retire(std::unique_ptr<PluginInstance> old, Loop& loop, Loop::Publication pub, bool unloaded);
+  static void finish(PluginInstance& inst, bool unloaded) noexcept;
   void record(HostEvent e);
   void drain_locked();
 
@@ -121,7 +139,8 @@ class PluginHost {
   PortRegistry ports_;
   std::vector<std::unique_ptr<Loop>> loops_;
   std::vector<Managed> managed_;
-  std::vector<std::unique_ptr<PluginInstance>> retired_;  // replaced, awaiting a late adoption
+  std::vector<Retired> retired_;  // replaced or unloaded, awaiting a late adoption
+  std::chrono::milliseconds adopt_timeout_ = kAdoptTimeout;
   std::vector<HostEvent> events_;
   std::uint64_t faults_ = 0;
   EventSink sink_;

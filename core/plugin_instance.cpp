@@ -123,7 +123,14 @@ void PluginInstance::apply_param_changes_rt() noexcept {
 }
 
 FaultKind PluginInstance::update_rt(const crease_cycle& cycle, Status& status) noexcept {
-  const std::int32_t code = d_.update(self_, &cycle);
+  return classify_rt(d_.update(self_, &cycle), cycle, status);
+}
+
+FaultKind PluginInstance::write_rt(const crease_cycle& cycle, Status& status) noexcept {
+  return classify_rt(d_.write(self_, &cycle), cycle, status);
+}
+
+FaultKind PluginInstance::classify_rt(std::int32_t code, const crease_cycle& cycle, Status& status) noexcept {
   FaultKind kind = FaultKind::none;
   if (flags_.non_finite) {
     kind = FaultKind::non_finite_output;

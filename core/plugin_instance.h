@@ -69,6 +69,9 @@ class PluginInstance {
   // Runs update and classifies the outcome; on a fault drives outputs safe and marks faulted.
   // Returns the fault kind (none when it went on).
   FaultKind update_rt(const crease_cycle& cycle, Status& status) noexcept;
+  // The write phase (after every instance's update), classified as update_rt. Only when has_write().
+  FaultKind write_rt(const crease_cycle& cycle, Status& status) noexcept;
+  [[nodiscard]] bool has_write() const noexcept { return d_.write != nullptr; }
   void drive_safe_outputs_rt(std::int64_t stamp_ns) noexcept { drive_safe_outputs(stamp_ns); }
   std::size_t save_state_rt(void* buf, std::size_t cap) noexcept { return d_.save_state(self_, buf, cap); }
   bool load_state_rt(const void* buf, std::size_t len) noexcept { return d_.load_state(self_, buf, len) == 0; }
@@ -84,6 +87,8 @@ class PluginInstance {
   [[nodiscard]] const std::vector<SafeOutput>& safe_outputs() const noexcept { return binder_.safe_outputs(); }
 
  private:
+  FaultKind classify_rt(std::int32_t code, const crease_cycle& cycle, Status& status) noexcept;
+
   struct ParamChange {
     std::uint32_t index;
     double value;

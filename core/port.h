@@ -82,14 +82,25 @@ class LatestOutput {
   detail::OutputFlags* flags_ = nullptr;
 };
 
-// The reading end of a latest port. RT-safe.
+// The reading end of a latest port. It keeps the newest value itself: call poll() once per
+// cycle, then use value(), which holds the newest value also on cycles when nothing new
+// arrived (a command written once stays the command).
+//   const auto info = in_.poll();          // RT-safe
+//   if (!info.has_data()) return Status::degraded;   // never written: value() is T{}
+//   use(in_.value());                      // info.is_new() tells whether it changed
+// Binding allocates (configure time); the end is move-only.
 template <PortPayload T>
 class LatestInput {
  public:
   LatestInput() = default;
-  explicit LatestInput(const rt::LatestChannel* ch) noexcept : reader_(ch) {}
-  // Copies the newest value into out if there is one. info.flow says none / old / new.
-  rt::ReadInfo read(T& out) noexcept { return reader_.read(out); }
+  explicit LatestInput(const rt::LatestChannel* ch) : reader_(ch) {}
+  // RT-safe. Takes the newest value into value(); flow says none / old (value() unchanged) / new.
+  rt::ReadInfo poll() noexcept { return reader_.poll(); }
+  // The newest value taken (T{} before the first). Stable until the next poll().
+  [[nodiscard]] const T& value() const noexcept { return reader_.value(); }
+  [[nodiscard]] bool has_value() const noexcept { return reader_.has_value(); }
+  // Sequence number and timestamp of the value held.
+  [[nodiscard]] const rt::ReadInfo& held() const noexcept { return reader_.held(); }
   [[nodiscard]] bool bound() const noexcept { return reader_.bound(); }
 
  private:

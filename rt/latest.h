@@ -16,6 +16,7 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <type_traits>
 
 namespace crease::rt {
 
@@ -49,10 +50,11 @@ class LatestChannel {
   // Single writer. Wait-free, RT-safe. `data` points at payload_size() bytes.
   void write(const void* data, std::int64_t stamp_ns) noexcept;
 
-  // Any thread. Copies the newest value into `out` (payload_size() bytes) when there is one;
-  // `last_seen_seq` decides old vs new. Bounded retries; RT-safe. If the writer kept lapping the
-  // reader for kMaxReadTries attempts, returns old_data with the reader's last_seen_seq and
-  // leaves `out` untouched.
+  // Any thread. Copies the newest value into `out` (payload_size() bytes) when it is newer than
+  // `last_seen_seq`; on old data copies nothing (the caller has it: LatestReader keeps it).
+  // Bounded retries; RT-safe. If the writer kept lapping the reader for kMaxReadTries attempts,
+  // returns old_data (no_data if last_seen_seq is 0) with last_seen_seq, and `out` may hold a
+  // torn copy: read into a buffer that is not the value in use (LatestReader does).
   ReadInfo read(void* out, std::uint64_t last_seen_seq) const noexcept;
 
   // Newest published sequence number (0 = never written). Any thread.
@@ -99,24 +101,46 @@ class LatestWriter {
   LatestChannel* ch_ = nullptr;
 };
 
+// The reading end keeps the newest value it has taken (value()), so a reader never has to
+// remember to keep a copy: on a cycle with nothing new, value() is still the newest value.
+// Two buffers: a copy that the writer tore (and that the channel retried or gave up on) lands
+// in the back buffer and never reaches value().
 template <class T>
 class LatestReader {
   static_assert(std::is_trivially_copyable_v<T>, "port payloads are plain structs");
 
  public:
   LatestReader() = default;
-  explicit LatestReader(const LatestChannel* ch) noexcept : ch_(ch) {}
-  // Copies the newest value into `out` if there is one; tells whether it is new to this reader.
-  ReadInfo read(T& out) noexcept {
-    ReadInfo info = ch_->read(&out, last_seen_);
-    if (info.has_data()) last_seen_ = info.seq;
-    return info;
+  // Non-RT: allocates the reader's two buffers (value-initialised).
+  explicit LatestReader(const LatestChannel* ch) : ch_(ch), bufs_(new T[2]{}) {}
+
+  // RT-safe. Takes the newest value into value() when it is new to this reader and tells what it
+  // found: no_data (never written: value() stays T{}), old_data (value() unchanged, info of the
+  // value held), new_data (value() is the new value).
+  ReadInfo poll() noexcept {
+    const ReadInfo info = ch_->read(&bufs_[1 - front_], held_.seq);
+    if (info.is_new()) {
+      front_ = 1 - front_;
+      held_ = info;
+      return info;
+    }
+    if (held_.seq == 0) return ReadInfo{};
+    ReadInfo old = held_;
+    old.flow = Flow::old_data;
+    return old;
   }
+  // The newest value taken by poll() (T{} before any). Stable until the next poll().
+  [[nodiscard]] const T& value() const noexcept { return bufs_[front_]; }
+  // What the held value is: its sequence number (0 = none yet) and timestamp.
+  [[nodiscard]] const ReadInfo& held() const noexcept { return held_; }
+  [[nodiscard]] bool has_value() const noexcept { return held_.seq != 0; }
   [[nodiscard]] bool bound() const noexcept { return ch_ != nullptr; }
 
  private:
   const LatestChannel* ch_ = nullptr;
-  std::uint64_t last_seen_ = 0;
+  std::unique_ptr<T[]> bufs_;
+  int front_ = 0;
+  ReadInfo held_{};
 };
 
 }  // namespace crease::rt

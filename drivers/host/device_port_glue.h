@@ -54,25 +54,11 @@ void fill_link_state(State& s, const Host& host) noexcept {
   s.commands_failed = c.commands_failed;
 }
 
-// The newest command of a latest-value input, kept across cycles (commands are never queued).
+// The newest command of a latest-value input, held across cycles (commands are never queued):
+// nullptr until a first command has arrived (the driver then holds). RT-safe.
 template <typename Command>
-class HeldCommand {
- public:
-  void bind(LatestInput<Command> in) noexcept { in_ = in; }
-  // Reads the input; nullptr until a first command has arrived (the driver then holds).
-  const Command* poll() noexcept {
-    Command in;
-    if (in_.read(in).has_data()) {
-      value_ = in;
-      have_ = true;
-    }
-    return have_ ? &value_ : nullptr;
-  }
-
- private:
-  LatestInput<Command> in_;
-  Command value_;
-  bool have_ = false;
-};
+[[nodiscard]] const Command* held_command(LatestInput<Command>& in) noexcept {
+  return in.poll().has_data() ? &in.value() : nullptr;
+}
 
 }  // namespace crease::drivers

@@ -3,6 +3,8 @@
 //   output arm_state   (latest ArmState: positions, velocities, drive state, health, acks)
 // Parameters: bus_kind ("mock" | "socketcan"), bus (required), node (required, 1..126),
 //   host_node (mock, default 100), timeout_cycles (2), crc_threshold (10).
+// Cycle phases: update reads the bus and publishes arm_state; write sends the newest arm_command
+// (a controller after the driver in the loop is answered in the same cycle).
 // The drive is brought to operation enabled by the driver itself (and fault-reset when it
 // reports a fault); set points reach it only there. A link fault commands quick stop in the
 // same cycle and is reported as Status::degraded with health = fault: the plugin stays
@@ -25,10 +27,11 @@ class ArmDriver final : public Plugin {
     dr::ArmHostConfig cfg;
     bus_ = dr::configure_can_device(p, cfg, 10);
     host_ = std::make_unique<dr::ArmHost>(*bus_, cfg);
-    command_.bind(ports.latest_input<ArmCommand>("arm_command"));
+    command_ = ports.latest_input<ArmCommand>("arm_command");
     state_out_ = ports.latest_output<ArmState>("arm_state", ArmState{});
   }
 
+  // Read phase: the bus; publishes arm_state for the controllers that run after it.
   Status update(const Cycle& cycle) override {
     const std::int64_t now = cycle.time_ns;
     host_->read_from_rt(now);
@@ -40,9 +43,16 @@ class ArmDriver final : public Plugin {
       state_.position_rad[j] = r.status.position_rad[j];
       state_.velocity_rad_s[j] = r.status.velocity_rad_s[j];
     }
+    state_.safe_state = host_->health() == dr::LinkHealth::fault ? 1 : 0;  // this cycle's write sends quick stop
+    state_out_.write(state_, now);
+    return dr::to_plugin_status(host_->health());
+  }
 
+  // Write phase: the newest arm_command (this cycle's, or held) goes out with the SYNC.
+  Status write(const Cycle& cycle) {
+    const dr::ArmReading& r = host_->reading();
     dr::arm::Command cmd;
-    if (const ArmCommand* in = command_.poll()) {
+    if (const ArmCommand* in = dr::held_command(command_)) {
       cmd.mode = in->mode == ArmCommand::velocity ? dr::arm::kModeCyclicVelocity : dr::arm::kModeCyclicPosition;
       for (int j = 0; j < ArmCommand::kJoints; ++j) {
         cmd.position_rad[j] = in->position_rad[j];
@@ -51,16 +61,14 @@ class ArmDriver final : public Plugin {
     } else {
       for (int j = 0; j < ArmCommand::kJoints; ++j) cmd.position_rad[j] = r.status.position_rad[j];
     }
-    host_->write_from_rt(cmd, now);
-    state_.safe_state = host_->commanding_safe_state() ? 1 : 0;
-    state_out_.write(state_, now);
+    host_->write_from_rt(cmd, cycle.time_ns);
     return dr::to_plugin_status(host_->health());
   }
 
  private:
   std::unique_ptr<dr::CanBus> bus_;
   std::unique_ptr<dr::ArmHost> host_;
-  dr::HeldCommand<ArmCommand> command_;
+  LatestInput<ArmCommand> command_;
   LatestOutput<ArmState> state_out_;
   ArmState state_;
 };

@@ -13,6 +13,9 @@
 //   tactile_rate_hz 1..1000 (default 250)
 //   timeout_cycles  cycles without a fresh status before fault (default 2)
 //   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
+// Cycle phases: update reads the bus and publishes hand_state / tactile; write sends the newest
+// hand_command, so a controller that runs after the driver in the loop has its command sent in
+// the same cycle as the status it was built from.
 // A link fault (device silent, bus-off, CRC errors, emergency) commands the safe state (hold,
 // zero force) in the same cycle and is reported as Status::degraded with health = fault in
 // hand_state: the plugin stays scheduled so it recovers by itself when the device returns,
@@ -50,10 +53,12 @@ class HandDriver final : public Plugin {
       tactile_host_ = std::make_unique<dr::TactileHost>(serial_->fd(), tc);
       tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
     }
-    command_.bind(ports.latest_input<HandCommand>("hand_command"));
+    command_ = ports.latest_input<HandCommand>("hand_command");
     state_out_ = ports.latest_output<HandState>("hand_state", HandState{});
   }
 
+  // Read phase: the bus and the tactile link; publishes hand_state and tactile for the
+  // controllers that run after this plugin's update in the same cycle.
   Status update(const Cycle& cycle) override {
     const std::int64_t now = cycle.time_ns;
     host_->read_from_rt(now);
@@ -62,20 +67,10 @@ class HandDriver final : public Plugin {
     for (int j = 0; j < HandState::kJoints; ++j) state_.position_rad[j] = r.status.position_rad[j];
     for (int k = 0; k < HandState::kPressureSensors; ++k) state_.pressure_kpa[k] = r.pressure.pressure_kpa[k];
     state_.pressure_valid = r.pressure_fresh ? r.pressure.valid : 0;
-
-    dr::hand::Command cmd;
-    dr::hand::Stiffness stiff;
-    if (const HandCommand* in = command_.poll()) {
-      cmd.flags = in->enable ? dr::hand::kCmdEnable : 0;
-      for (int j = 0; j < HandCommand::kJoints; ++j) {
-        cmd.target_rad[j] = in->target_rad[j];
-        stiff.stiffness_nm_per_rad[j] = in->stiffness_nm_per_rad[j];
-      }
-    } else {
-      for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
-    }
-    host_->write_from_rt(cmd, stiff, now);
-    state_.safe_state = (host_->commanding_safe_state() || !cmd.flags) ? 1 : 0;
+    // The write phase of this cycle sends the safe state on a link fault; with no command, or a
+    // disabled one (as held from the last write phase), it holds with zero force.
+    const bool enabled = command_.has_value() && command_.value().enable;
+    state_.safe_state = host_->health() == dr::LinkHealth::fault || !enabled ? 1 : 0;
     state_out_.write(state_, now);
 
     Status status = dr::to_plugin_status(host_->health());
@@ -97,12 +92,31 @@ class HandDriver final : public Plugin {
     return status;
   }
 
+  // Write phase: the newest hand_command (written by a controller in this cycle's update, or
+  // held from an earlier one) goes out with the SYNC; no command yet: hold the measured pose.
+  Status write(const Cycle& cycle) {
+    const dr::HandReading& r = host_->reading();
+    dr::hand::Command cmd;
+    dr::hand::Stiffness stiff;
+    if (const HandCommand* in = dr::held_command(command_)) {
+      cmd.flags = in->enable ? dr::hand::kCmdEnable : 0;
+      for (int j = 0; j < HandCommand::kJoints; ++j) {
+        cmd.target_rad[j] = in->target_rad[j];
+        stiff.stiffness_nm_per_rad[j] = in->stiffness_nm_per_rad[j];
+      }
+    } else {
+      for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
+    }
+    host_->write_from_rt(cmd, stiff, cycle.time_ns);
+    return dr::to_plugin_status(host_->health());
+  }
+
  private:
   std::unique_ptr<dr::CanBus> bus_;
   std::unique_ptr<dr::HandHost> host_;
   std::unique_ptr<dr::SerialPort> serial_;
   std::unique_ptr<dr::TactileHost> tactile_host_;
-  dr::HeldCommand<HandCommand> command_;
+  LatestInput<HandCommand> command_;
   LatestOutput<HandState> state_out_;
   LatestOutput<Tactile> tactile_out_;
   HandState state_;

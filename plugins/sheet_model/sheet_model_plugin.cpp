@@ -50,8 +50,6 @@ class SheetModelPlugin final : public Plugin {
     const double table = p.get_in_range<double>("table_height_mm", 0.0, -1e4, 1e4);
     runner_ = std::make_unique<sheet::SheetRunner>(sp, table);
     state_ = std::make_unique<SheetState>();
-    keypoints_buf_ = std::make_unique<Keypoints>();
-    targets_buf_ = std::make_unique<TargetPoints>();
     keypoints_ = ports.latest_input<Keypoints>("keypoints");
     targets_ = ports.latest_input<TargetPoints>("target_points");
     crease_ = ports.queue_input<SheetCreaseEvent>("crease");
@@ -61,11 +59,8 @@ class SheetModelPlugin final : public Plugin {
   }
 
   Status update(const Cycle& cycle) override {
-    if (keypoints_.bound() && keypoints_.read(*keypoints_buf_).is_new()) runner_->observe_keypoints(*keypoints_buf_);
-    if (targets_.bound()) {
-      const auto info = targets_.read(*targets_buf_);
-      if (info.is_new()) runner_->set_targets(*targets_buf_);
-    }
+    if (keypoints_.bound() && keypoints_.poll().is_new()) runner_->observe_keypoints(keypoints_.value());
+    if (targets_.bound() && targets_.poll().is_new()) runner_->set_targets(targets_.value());
     SheetResetEvent r;
     while (reset_.bound() && reset_.try_pop(r)) runner_->apply(r);
     SheetCreaseEvent c;
@@ -83,8 +78,6 @@ class SheetModelPlugin final : public Plugin {
  private:
   std::unique_ptr<sheet::SheetRunner> runner_;
   std::unique_ptr<SheetState> state_;
-  std::unique_ptr<Keypoints> keypoints_buf_;
-  std::unique_ptr<TargetPoints> targets_buf_;
   LatestInput<Keypoints> keypoints_;
   LatestInput<TargetPoints> targets_;
   QueueInput<SheetCreaseEvent> crease_;

@@ -2,8 +2,8 @@
 #include "core/abi.h"
 
 extern "C" CREASE_EXPORT const crease_plugin_descriptor* crease_plugin_entry(void) {
-  static const crease_plugin_descriptor d{CREASE_PLUGIN_ABI_VERSION + 98, sizeof(crease_plugin_descriptor),
+  static const crease_plugin_descriptor d{99u, sizeof(crease_plugin_descriptor),
                                           "test_wrong_abi", "1.0.0", nullptr, nullptr, nullptr, nullptr, nullptr,
-                                          nullptr, nullptr, nullptr, nullptr, nullptr};
+                                          nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
   return &d;
 }

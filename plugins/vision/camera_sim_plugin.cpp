@@ -45,7 +45,6 @@ class CameraSimPlugin final : public CameraPlugin {
     };
     if (truth == "port") {
       truth_in_ = ports.latest_input<crease::SheetState>("sheet_truth");
-      truth_buf_ = std::make_unique<crease::SheetState>();
       truth_ch_ = std::make_shared<crease::rt::LatestChannel>(sizeof(crease::SheetState));
       mesh_at = [ch = truth_ch_, buf = std::make_shared<crease::SheetState>(),
                  fallback = flat_sheet(22, 31, layout.sheet_w_mm, layout.sheet_h_mm, {0, 0, 0},
@@ -75,14 +74,12 @@ class CameraSimPlugin final : public CameraPlugin {
 
   crease::Status update(const crease::Cycle& cycle) override {
     // Hand the newest truth to the renderer before asking for the next frame.
-    if (truth_in_.bound() && truth_in_.read(*truth_buf_).is_new())
-      truth_ch_->write(truth_buf_.get(), cycle.time_ns);
+    if (truth_in_.bound() && truth_in_.poll().is_new()) truth_ch_->write(&truth_in_.value(), cycle.time_ns);
     return CameraPlugin::update(cycle);
   }
 
  private:
   crease::LatestInput<crease::SheetState> truth_in_;
-  std::unique_ptr<crease::SheetState> truth_buf_;
   std::shared_ptr<crease::rt::LatestChannel> truth_ch_;
 };
 

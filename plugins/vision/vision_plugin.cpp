@@ -69,14 +69,15 @@ class VisionPlugin final : public crease::Plugin {
 
   crease::Status update(const crease::Cycle& cycle) override {
     bool source_degraded = false;
-    if (frames_in_.read(announce_).has_data()) {
-      if (std::strncmp(announce_.channel, channel_name_, sizeof channel_name_) != 0) {
+    if (frames_in_.poll().has_data()) {
+      const crease::CameraFrames& announce = frames_in_.value();
+      if (std::strncmp(announce.channel, channel_name_, sizeof channel_name_) != 0) {
         if (!warned_channel_)
           log_rt(crease::rt::LogLevel::warn, "the frames port announces another frame channel");
         warned_channel_ = true;
         source_degraded = true;
       }
-      source_degraded = source_degraded || announce_.ended != 0;
+      source_degraded = source_degraded || announce.ended != 0;
     }
     switch (worker_->take_rt(*buf_)) {
       case VisionWorker::Take::fresh:
@@ -108,7 +109,6 @@ class VisionPlugin final : public crease::Plugin {
   std::unique_ptr<crease::Keypoints> buf_;
   crease::LatestInput<crease::CameraFrames> frames_in_;
   crease::LatestOutput<crease::Keypoints> out_;
-  crease::CameraFrames announce_{};
   char channel_name_[crease::CameraFrames::kChannelNameCapacity] = {};
   bool warned_channel_ = false;
   int stale_cycles_ = 10;

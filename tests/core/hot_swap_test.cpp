@@ -81,3 +81,83 @@ TEST_CASE("hot-swaps carry the count across versions without a skip or a repeat"
   for (const auto& e : host.events()) swap_events += e.type == crease::HostEvent::Type::swapped;
   CHECK(swap_events == kSwaps);
 }
+
+// Two loops whose changes are always adopted late (a timeout of 0 against 10 ms and 7.7 ms
+// periods), hot-swapped from two threads at once: each replaced instance must live until its
+// own loop has moved past it (freeing it when the other loop acknowledges is a use after free
+// that ASan and TSan see), a loop with a change pending refuses the next one ("retry"), and
+// the counts carry over with no skip or repeat.
+TEST_CASE("hot-swaps in two loops at once, adopted late: each instance freed after its own loop let go") {
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"a", 100.0, 0, -1});
+  host.add_loop({"b", 130.0, 0, -1});
+  for (const std::string loop : {"a", "b"}) {
+    crease::InstanceSpec s;
+    s.name = loop + "_counter";
+    s.library = "crease_test_counter_v1";
+    s.loop = loop;
+    s.ports = {{"count", loop + "_count"}, {"counts", loop + "_counts"}};
+    host.add_instance(s);
+  }
+  host.set_adopt_timeout(0ms);
+  host.start();
+#if defined(CREASE_SANITIZER_THREAD) || defined(CREASE_SANITIZER_ADDRESS)
+  constexpr int kPerLoop = 40;
+#else
+  constexpr int kPerLoop = 100;
+#endif
+  struct Result {
+    std::uint64_t skips = 0, repeats = 0, counted = 0, refused = 0;
+  };
+  auto swapper = [&](const std::string& loop, Result& r) {
+    crease::rt::QueueChannel* counts = host.ports().find_queue(loop + "_counts");
+    std::uint64_t expected = 1;
+    auto drain = [&] {
+      TestValue v;
+      while (counts->try_pop(&v)) {
+        r.skips += v.count > expected;
+        r.repeats += v.count < expected;
+        expected = v.count + 1;
+        ++r.counted;
+      }
+    };
+    for (int i = 0; i < kPerLoop; ++i) {
+      const char* lib = i % 2 == 0 ? "crease_test_counter_v2" : "crease_test_counter_v1";
+      for (;;) {
+        try {
+          host.swap(loop + "_counter", lib);
+          break;
+        } catch (const crease::Error& e) {
+          REQUIRE(std::string(e.what()).find("retry") != std::string::npos);
+          ++r.refused;
+          host.poll();
+          drain();
+          std::this_thread::sleep_for(200us);
+        }
+      }
+      drain();
+    }
+    for (int i = 0; i < 2000 && host.retired_count() != 0; ++i) {
+      host.poll();
+      drain();
+      std::this_thread::sleep_for(1ms);
+    }
+    drain();
+  };
+  Result ra, rb;
+  std::thread ta([&] { swapper("a", ra); });
+  std::thread tb([&] { swapper("b", rb); });
+  ta.join();
+  tb.join();
+  host.stop();
+  CHECK(host.retired_count() == 0);
+  for (const Result* r : {&ra, &rb}) {
+    CHECK(r->skips == 0);
+    CHECK(r->repeats == 0);
+    CHECK(r->counted > 0);
+    CHECK(r->refused > 0);  // late adoptions really happened
+  }
+  std::uint64_t swap_events = 0;
+  for (const auto& e : host.events()) swap_events += e.type == crease::HostEvent::Type::swapped;
+  CHECK(swap_events == 2 * kPerLoop);
+}

@@ -46,7 +46,11 @@ TEST_CASE("a good plugin loads and its descriptor is copied") {
 
 TEST_CASE("each refusal names the file and the reason") {
   CHECK(error_of([] { crease::PluginLibrary::open("crease_test_wrong_abi", {kDir}); })
-            .find("it was built for plugin ABI 99, this host speaks ABI 1") != std::string::npos);
+            .find("it was built for plugin ABI 99, this host speaks ABI 2") != std::string::npos);
+  // A plugin of the ABI before the write phase: refused by its version, before its descriptor
+  // (a shorter struct) is read any further.
+  CHECK(error_of([] { crease::PluginLibrary::open("crease_test_abi_v1", {kDir}); })
+            .find("it was built for plugin ABI 1, this host speaks ABI 2 (rebuild the plugin)") != std::string::npos);
   CHECK(error_of([] { crease::PluginLibrary::open("crease_test_no_entry", {kDir}); })
             .find("libcrease_test_no_entry.so' refused: it has no entry point 'crease_plugin_entry'") != std::string::npos);
   CHECK(error_of([] { crease::PluginLibrary::open("does_not_exist", {kDir}); })

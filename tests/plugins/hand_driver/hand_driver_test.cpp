@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <thread>
 
@@ -10,8 +11,11 @@
 #include "drivers/can/mock_can_broker.h"
 #include "drivers/can/mock_can_bus.h"
 #include "drivers/simdevice/device_thread.h"
+#include "drivers/simdevice/sense_to_command_tap.h"
 #include "drivers/simdevice/sim_hand.h"
 #include "rt/alloc_guard.h"
+#include "rt/clock.h"
+#include "tests/drivers/hil/command_tap.h"
 #include "tests/drivers/hil/driver_plugin_rig.h"
 
 using namespace crease;
@@ -52,4 +56,130 @@ TEST_CASE("hand_driver: fresh state, no allocation, safe within 3 cycles of sile
 
 TEST_CASE("hand_driver: a bus nobody serves is a configuration error naming the key") {
   Rig("hand_r", "hand_driver", "hand_state").check_unserved_bus_is_config_error();
+}
+
+namespace {
+// The command the test writes: every joint a distinct, non-zero target.
+float target_of(int j, float offset) { return 0.1f + offset + 0.01f * static_cast<float>(j); }
+bool matches_held(const dr::hand::Command& c) {
+  if (!(c.flags & dr::hand::kCmdEnable)) return false;
+  for (int j = 0; j < dr::hand::kJoints; ++j)
+    if (std::fabs(c.target_rad[j] - target_of(j, 0.0f)) > 1e-3f) return false;
+  return true;
+}
+bool all_zero(const dr::hand::Command& c) {
+  for (float t : c.target_rad)
+    if (std::fabs(t) > 1e-4f) return false;
+  return true;
+}
+HandCommand command_with(float offset) {
+  HandCommand c;
+  c.enable = 1;
+  for (int j = 0; j < HandCommand::kJoints; ++j) {
+    c.target_rad[j] = target_of(j, offset);
+    c.stiffness_nm_per_rad[j] = 2.0f;
+  }
+  return c;
+}
+// Waits (at most 5 s) until pred() holds.
+template <class P>
+bool eventually(P pred) {
+  for (int i = 0; i < 5000 && !pred(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return pred();
+}
+}  // namespace
+
+// The device side sees every command frame: a command written once must be the command of
+// every cycle after it (the driver must not fall back to a default, all-zero command on the
+// cycles when nothing new arrived). timeout_cycles is wide so that a late wake-up of a loaded
+// machine does not put the link into its safe state during the count.
+TEST_CASE("hand_driver: a command written once is held unchanged, frame after frame, for 1000 cycles") {
+  const std::string bus = "plug-hand-hold-" + std::to_string(::getpid());
+  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
+  dr::MockCanBus dev_bus({bus, 1, 1'000'000, 5'000'000});
+  dr::testing::CommandTap<dr::hand::Command> tap(dev_bus, 1, &matches_held, &all_zero);
+  dr::sim::SimHand hand(tap, {.node = 1});
+  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
+
+  Rig rig("hand_r", "hand_driver", "hand_state");
+  rig.add("{bus: " + bus + ", node: 1, timeout_cycles: 100}");
+  auto* cmd = rig.host.ports().bind_latest_writer("hand_command", port_type_of<HandCommand>(), "test");
+  rig.host.start();
+  REQUIRE(eventually([&] { return rig.state().health == DeviceHealth::ok; }));
+  const HandCommand once = command_with(0.0f);
+  cmd->write(&once, rt::now_ns());
+  REQUIRE(eventually([&] { return tap.matching.load() > 0; }));  // the command reached the device
+  tap.arm();
+  const auto start = tap.total.load();
+  REQUIRE(eventually([&] { return tap.total.load() >= start + 1000; }));
+  rig.host.stop();
+  CHECK(tap.matching.load() >= 1000);
+  CHECK(tap.differing.load() == 0);
+  CHECK(tap.zeros.load() == 0);
+}
+
+// A 60 Hz writer (the model loop's rate) feeding the 1 kHz driver: ~16 driver cycles per
+// command; none of them may send a zero command once the first command arrived.
+TEST_CASE("hand_driver: a 60 Hz command writer never produces a zero command frame at 1 kHz") {
+  const std::string bus = "plug-hand-60-" + std::to_string(::getpid());
+  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
+  dr::MockCanBus dev_bus({bus, 1, 1'000'000, 5'000'000});
+  dr::testing::CommandTap<dr::hand::Command> tap(dev_bus, 1, &matches_held, &all_zero);
+  dr::sim::SimHand hand(tap, {.node = 1});
+  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
+
+  Rig rig("hand_r", "hand_driver", "hand_state");
+  rig.add("{bus: " + bus + ", node: 1, timeout_cycles: 100}");
+  auto* cmd = rig.host.ports().bind_latest_writer("hand_command", port_type_of<HandCommand>(), "test");
+  rig.host.start();
+  REQUIRE(eventually([&] { return rig.state().health == DeviceHealth::ok; }));
+  const HandCommand first = command_with(0.0f);
+  cmd->write(&first, rt::now_ns());
+  REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
+  tap.arm();
+  const auto frames_before = tap.total.load();
+  for (int i = 1; i <= 60; ++i) {  // one second at 60 Hz
+    std::this_thread::sleep_for(std::chrono::microseconds(16'667));
+    const HandCommand c = command_with(0.05f * std::sin(0.3f * static_cast<float>(i)));
+    cmd->write(&c, rt::now_ns());
+  }
+  rig.host.stop();
+  CHECK(tap.total.load() - frames_before > 500);
+  CHECK(tap.zeros.load() == 0);
+}
+
+// The write phase seen from the hand: a controller that runs after the driver (hand_echo, order
+// 20) builds each command from the status the driver read in that cycle, and the driver sends
+// it in the same cycle: the command the hand receives answers the newest status it sent (lag
+// 0). Without a write phase the driver would send in its update, before the controller ran:
+// lag 1 at best. A late wake-up of a loaded machine makes single cycles lag; the typical one
+// must be 0.
+TEST_CASE("hand_driver: a status received in cycle k is answered by a command built from it in cycle k") {
+  const std::string bus = "plug-hand-lag-" + std::to_string(::getpid());
+  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
+  dr::MockCanBus dev_bus({bus, 1, 1'000'000, 5'000'000});
+  dr::sim::SenseToCommandTap tap(dev_bus, 1);
+  dr::sim::SimHand hand(tap, {.node = 1});
+  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
+
+  Rig rig("hand_r", "hand_driver", "hand_state");
+  rig.add("{bus: " + bus + ", node: 1, timeout_cycles: 100}");
+  InstanceSpec echo;
+  echo.name = "echo";
+  echo.library = "crease_test_hand_echo";
+  echo.loop = "control";
+  echo.order = 20;
+  rig.host.add_instance(echo);
+  rig.host.start();
+  auto counted = [&] {
+    std::uint64_t n = 0;
+    for (int k = 0; k < dr::sim::SenseToCommandTap::kLags; ++k) n += tap.commands_with_lag(k);
+    return n;
+  };
+  REQUIRE(eventually([&] { return counted() >= 1000; }));
+  rig.host.stop();
+  MESSAGE("lag 0: " << tap.commands_with_lag(0) << ", 1: " << tap.commands_with_lag(1) << ", 2: "
+                    << tap.commands_with_lag(2) << ", more: " << tap.commands_with_lag(3));
+  CHECK(tap.typical_lag() == 0);
+  CHECK(tap.commands_with_lag(0) * 2 > counted());
 }
