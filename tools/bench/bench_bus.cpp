@@ -2,7 +2,9 @@
 // Mock CAN bus round trip (through the broker) beside a bare AF_UNIX SOCK_SEQPACKET ping-pong;
 // sustained frames/s with loss and reordering counted; pty serial round trip (framed) beside a
 // raw byte ping-pong on the same pty; one control cycle of four drivers (2 hands, 2 arms:
-// read all, write all) against simulated devices, beside the bare syscall floor.
+// read all, write all) against simulated devices, beside the bare syscall floor, each with its
+// share of late round trips; the sensing-to-command lag through the plugin loop (write phase)
+// beside a loop of one update per plugin.
 // The mock bus moves frames through shared-memory rings served by one broker thread per
 // process (drivers/can/mock_reactor.h); the drivers' cycle pays a system call only when that
 // thread sleeps, and the count of such wake-ups is printed beside the cycle figure.
@@ -31,7 +33,9 @@
 #include "drivers/simdevice/device_thread.h"
 #include "drivers/simdevice/sim_arm.h"
 #include "drivers/simdevice/sim_clock.h"
+#include "drivers/simdevice/sense_to_command_tap.h"
 #include "drivers/simdevice/sim_hand.h"
+#include "core/plugin_host.h"
 #include "rt/clock.h"
 
 namespace {
@@ -240,7 +244,9 @@ std::vector<double> serial_rtt(int n, bool framed) {
 }
 
 // --- 4. control cycle of four drivers ----------------------------------------------------------
-std::vector<double> control_cycle(int cycles) {
+// Fills late_share: the share of commands not acknowledged within 2 cycles (a late round trip)
+// over the measured cycles, the four links together.
+std::vector<double> control_cycle(int cycles, double& late_share) {
   std::vector<std::unique_ptr<MockCanBroker>> brokers;
   std::vector<std::unique_ptr<MockCanBus>> host_buses, dev_buses;
   for (int i = 0; i < 4; ++i) {
@@ -263,17 +269,27 @@ std::vector<double> control_cycle(int cycles) {
   hand::Stiffness hs;
   arm::Command ac;
   std::vector<double> us;
+  auto link_totals = [&](std::uint64_t& sent, std::uint64_t& failed) {
+    sent = failed = 0;
+    for (auto& h : hands) sent += h.monitor().counters().commands_sent, failed += h.monitor().counters().commands_failed;
+    for (auto& a : arms) sent += a.monitor().counters().commands_sent, failed += a.monitor().counters().commands_failed;
+  };
+  std::uint64_t sent0 = 0, failed0 = 0;
   std::int64_t next = crease::rt::now_ns();
   for (int c = 0; c < cycles + 300; ++c) {
     next += 1'000'000;
     crease::rt::sleep_until_ns(next);
     const std::int64_t t = now_ns();
+    if (c == 300) link_totals(sent0, failed0);
     for (auto& h : hands) h.read_from_rt(t);
     for (auto& a : arms) a.read_from_rt(t);
     for (auto& h : hands) h.write_from_rt(hc, hs, t);
     for (auto& a : arms) a.write_from_rt(ac, t);
     if (c >= 300) us.push_back(static_cast<double>(now_ns() - t) * 1e-3);
   }
+  std::uint64_t sent1 = 0, failed1 = 0;
+  link_totals(sent1, failed1);
+  late_share = sent1 > sent0 ? static_cast<double>(failed1 - failed0) / static_cast<double>(sent1 - sent0) : 0.0;
   int ok = 0;
   for (auto& h : hands) ok += h.health() == LinkHealth::ok;
   for (auto& a : arms) ok += a.health() == LinkHealth::ok;
@@ -289,7 +305,8 @@ std::vector<double> control_cycle(int cycles) {
 // shared-memory rings) can cost per cycle. Four bare SEQPACKET socketpairs, each with a peer
 // thread blocked in poll() (so every send wakes it); per link one recv of a waiting frame and
 // one send of two frames.
-std::vector<double> syscall_floor(int cycles) {
+// late_share: the share of per-link cycles whose peer's answer had not arrived by the next cycle.
+std::vector<double> syscall_floor(int cycles, double& late_share) {
   int sv[4][2];
   for (auto& s : sv) ::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK, 0, s);
   std::atomic<bool> stop{false};
@@ -308,12 +325,19 @@ std::vector<double> syscall_floor(int cycles) {
   }
   std::vector<double> us;
   CanFrame f[2];
+  std::uint64_t late = 0, answers_due = 0;
   std::int64_t next = crease::rt::now_ns();
   for (int c = 0; c < cycles + 100; ++c) {
     next += 1'000'000;
     crease::rt::sleep_until_ns(next);
     const std::int64_t t = now_ns();
-    for (auto& s : sv) (void)!::recv(s[0], &f[0], sizeof(f[0]), MSG_DONTWAIT);
+    for (auto& s : sv) {
+      const bool got = ::recv(s[0], &f[0], sizeof(f[0]), MSG_DONTWAIT) > 0;
+      if (c > 100) {
+        ++answers_due;
+        late += got ? 0 : 1;
+      }
+    }
     for (auto& s : sv) {
       iovec iov[2] = {{&f[0], sizeof(CanFrame)}, {&f[1], sizeof(CanFrame)}};
       mmsghdr m[2] = {};
@@ -325,6 +349,7 @@ std::vector<double> syscall_floor(int cycles) {
     }
     if (c >= 100) us.push_back(static_cast<double>(now_ns() - t) * 1e-3);
   }
+  late_share = answers_due ? static_cast<double>(late) / static_cast<double>(answers_due) : 0.0;
   stop = true;
   for (auto& p : peers) p.join();
   for (auto& s : sv) {
@@ -332,6 +357,56 @@ std::vector<double> syscall_floor(int cycles) {
     ::close(s[1]);
   }
   return us;
+}
+
+// --- 5. sensing to command --------------------------------------------------------------------
+// hand_driver and the hand_echo test plugin (a controller that answers every hand_state) in a
+// PluginHost 1 kHz loop against a simulated hand whose bus is tapped: the hand sees how many
+// cycles old the status behind each command was. Ours: the echo after the driver, the driver
+// sending in its write phase. The alternative, what a loop of one update per plugin allows at
+// best: the echo before the driver (it works on the state the driver published last cycle).
+struct SenseToCommand {
+  int ours_lag = 0, alt_lag = 0;
+  double ours_lag0_share = 0, alt_lag0_share = 0;
+};
+void one_sense_to_command(int cycles, int echo_order, int& lag, double& lag0_share) {
+  const std::string name = bus_name("stc") + std::to_string(echo_order);
+  MockCanBroker broker(MockCanBrokerConfig{name, 1'000'000, 5'000'000, false});
+  MockCanBus dev_bus(MockCanBusConfig{name, 1, 1'000'000, 5'000'000});
+  sim::SenseToCommandTap tap(dev_bus, 1);
+  sim::SimHand hand(tap, {.node = 1});
+  sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); }, 1, 70);
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"control", 1000.0, 80, -1});
+  crease::InstanceSpec drv;
+  drv.name = "hand";
+  drv.library = "hand_driver";
+  drv.loop = "control";
+  drv.order = 10;
+  drv.params = crease::Params(YAML::Load("{bus: " + name + ", node: 1, timeout_cycles: 100}"), "bench", "hand.params");
+  host.add_instance(drv);
+  crease::InstanceSpec echo;
+  echo.name = "echo";
+  echo.library = "crease_test_hand_echo";
+  echo.loop = "control";
+  echo.order = echo_order;
+  host.add_instance(echo);
+  host.start();
+  auto counted = [&] {
+    std::uint64_t n = 0;
+    for (int k = 0; k < sim::SenseToCommandTap::kLags; ++k) n += tap.commands_with_lag(k);
+    return n;
+  };
+  for (int i = 0; i < 10 * cycles && counted() < static_cast<std::uint64_t>(cycles); ++i) ::usleep(1000);
+  host.stop();
+  lag = tap.typical_lag();
+  lag0_share = counted() ? static_cast<double>(tap.commands_with_lag(0)) / static_cast<double>(counted()) : 0.0;
+}
+SenseToCommand sense_to_command(int cycles) {
+  SenseToCommand r;
+  one_sense_to_command(cycles, 20, r.ours_lag, r.ours_lag0_share);
+  one_sense_to_command(cycles, 5, r.alt_lag, r.alt_lag0_share);
+  return r;
 }
 
 double arg(int argc, char** argv, const char* name, double def) {
@@ -370,16 +445,31 @@ int run_bus(int argc, char** argv) {
   std::printf("  COBS+CRC frames   %7.1f %7.1f %7.1f\n", sf.p50, sf.p99, sf.p999);
   std::printf("  raw bytes         %7.1f %7.1f %7.1f   ratio p99 %.2f\n", sr.p50, sr.p99, sr.p999, sf.p99 / sr.p99);
 
-  const Pct cy = percentiles(control_cycle(cycles));
+  double late_ours = 0, late_floor = 0;
+  const Pct cy = percentiles(control_cycle(cycles, late_ours));
   set_fifo(80);
-  const Pct fl = percentiles(syscall_floor(cycles));
+  const Pct fl = percentiles(syscall_floor(cycles, late_floor));
   set_fifo(0);
-  std::printf("control cycle, 4 drivers (us) p50 p99 p99.9\n");
-  std::printf("  drivers           %7.1f %7.1f %7.1f\n", cy.p50, cy.p99, cy.p999);
-  std::printf("  bare socketpairs  %7.1f %7.1f %7.1f   ratio p99 %.2f\n", fl.p50, fl.p99, fl.p999, cy.p99 / fl.p99);
+  std::printf("control cycle, 4 drivers (us) p50 p99 p99.9   late round trips\n");
+  std::printf("  drivers           %7.1f %7.1f %7.1f   %6.2f %%\n", cy.p50, cy.p99, cy.p999, 100 * late_ours);
+  std::printf("  bare socketpairs  %7.1f %7.1f %7.1f   %6.2f %%   ratio p99 %.2f\n", fl.p50, fl.p99, fl.p999,
+              100 * late_floor, cy.p99 / fl.p99);
+  std::printf("  (late: a command not acknowledged within 2 cycles; for the socketpairs, a peer's answer not\n"
+              "   there by the next cycle: both are the machine's scheduling of the device side)\n");
+
+  const SenseToCommand stc = sense_to_command(cycles);
+  std::printf("sensing to command through the 1 kHz loop (hand_driver + a controller after it), at the hand:\n");
+  std::printf("  write phase (ours)           typical lag %d cycles, %.1f %% of commands at lag 0\n", stc.ours_lag,
+              100 * stc.ours_lag0_share);
+  std::printf("  one update per plugin        typical lag %d cycles, %.1f %% of commands at lag 0\n", stc.alt_lag,
+              100 * stc.alt_lag0_share);
+  std::printf("  (without a write phase the best order is the controller before the driver, which then works\n"
+              "   on the previous cycle's sensing)\n");
   const bool clean = tp.lost == 0 && tp.reordered == 0;
-  std::printf("bus: rtt_p99_us=%.1f frames_per_s=%.0f serial_rtt_p99_us=%.1f cycle_p99_us=%.1f%s\n", ours.p99,
-              clean ? tp.fps : 0.0, sf.p99, cy.p99, clean ? "" : " (frames lost or reordered!)");
+  std::printf("bus: rtt_p99_us=%.1f frames_per_s=%.0f serial_rtt_p99_us=%.1f cycle_p99_us=%.1f late_rtt_pct=%.2f "
+              "late_floor_pct=%.2f sense_to_command_cycles=%d%s\n",
+              ours.p99, clean ? tp.fps : 0.0, sf.p99, cy.p99, 100 * late_ours, 100 * late_floor, stc.ours_lag,
+              clean ? "" : " (frames lost or reordered!)");
   return clean ? 0 : 1;
 }
 }  // namespace
