@@ -44,7 +44,9 @@ TEST_CASE("config/sim.yaml tracks the folding sheet and records every model fram
   // A loose bound on a shared machine (the figure of record comes from the run's own line):
   // a model that lost the sheet is off by 50 mm and more.
   CHECK(mean_mm < 10.0);
-  CHECK(frames > 500);
+  // 720 model frames in 12 s at 60 Hz; skipped periods of a loaded machine are counted, not
+  // replayed: only a stalled model loop scores fewer than half.
+  CHECK(frames > 360);
   CHECK(out.find("faults: 0") != std::string::npos);
 
   // The recording: one JSON object per model frame, 15x21 nodes in world mm, frames in order.
@@ -62,7 +64,7 @@ TEST_CASE("config/sim.yaml tracks the folding sheet and records every model fram
     last_frame = frame;
     ++lines;
   }
-  CHECK(lines > 500);
+  CHECK(lines > 360);
   CHECK(shaped);
   CHECK(in_order);
   CHECK(fs::exists(dir / "reports" / "report.html"));

@@ -63,7 +63,12 @@ TEST_CASE("an instance with a write phase is counted once per cycle") {
   host.add_instance(spec("probe", "crease_test_phase_probe", 10, {{"sensed", "s"}, {"command", "c"}}));
   host.add_instance(spec("controller", "crease_test_relay", 20, {{"in", "s"}, {"out", "c"}}));
   host.start();
-  std::this_thread::sleep_for(200ms);
+  auto updates_of = [&](const std::string& name) {
+    for (const auto& i : host.instances())
+      if (i.name == name) return i.stats->updates.load();
+    return std::uint64_t{0};
+  };
+  for (int i = 0; i < 5000 && updates_of("probe") <= 50; ++i) std::this_thread::sleep_for(1ms);
   host.stop();
   std::uint64_t probe_updates = 0, relay_updates = 0, probe_samples = 0;
   for (const auto& i : host.instances()) {

@@ -35,13 +35,16 @@ void body(void* ctx, const crease::rt::CycleClock& c) noexcept {
 TEST_CASE("a 1 kHz loop runs at its rate, on an RT-marked thread, and stops") {
   Recorder rec;
   crease::rt::PeriodicLoop loop({"t1k", 1'000'000, {}}, &body, &rec);
+  const auto t0 = std::chrono::steady_clock::now();
   loop.start();
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // It runs (however loaded the machine: up to 10 s for 100 cycles) and never faster than its
+  // rate: the mechanism, not the timing quality, which is crease-bench jitter's.
+  for (int i = 0; i < 2000 && rec.runs.load() < 100; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   loop.stop();
+  const auto elapsed_ms = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0).count();
   const auto runs = rec.runs.load();
-  // Loose bounds: the machine is shared; this checks the mechanism, not the timing quality.
-  CHECK(runs > 100);
-  CHECK(runs < 400);
+  CHECK(runs >= 100);
+  CHECK(runs <= elapsed_ms + 2);
   CHECK(rec.was_rt.load());
   CHECK(loop.timing().cycles.load() == runs);
   CHECK(loop.timing().wakeup_latency.count() == runs);
