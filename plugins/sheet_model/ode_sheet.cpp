@@ -29,7 +29,7 @@ OdeSheet::OdeSheet(const SheetParams& params, int iterations, int steps_per_fram
   prev_ = x_;
   force_.assign(n, Vec3{});
   w_.assign(n, 0.0);
-  kweight_.assign(n, 0.0);
+  coupling_.configure(n);
   kinematic_.assign(n, 0);
   bodies_.resize(n);
   for (int i = 0; i < n; ++i) {
@@ -106,27 +106,10 @@ void OdeSheet::substep(double dts) noexcept {
     }
     w_[i] = pinned_[i] ? 0.0 : 1.0 / mass_[i];
   }
-  // seed 000 Eqs. 1-3: node velocities from key-points (same blend as the XPBD backend).
-  if (n_keypoints_ > 0) {
-    const double lambda = std::min(keypoint_gain_, 1.0 / dts);
-    std::fill(force_.begin(), force_.end(), Vec3{});
-    std::fill(kweight_.begin(), kweight_.end(), 0.0);
-    for (int l = 0; l < n_keypoints_; ++l) {
-      const SheetPointStencil& s = keypoint_stencil_[l];
-      Vec3 c;
-      for (int e = 0; e < 4; ++e) c += s.bilinear[e] * x_[s.node[e]];
-      const Vec3 vl = lambda * (keypoints_[l].world_mm - c);
-      for (int e = 0; e < 4; ++e) {
-        force_[s.node[e]] += s.alpha[e] * vl;
-        kweight_[s.node[e]] += s.alpha[e];
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      if (pinned_[i] || kweight_[i] <= 0) continue;
-      const Vec3 v = (1.0 - std::min(kweight_[i], 1.0)) * v_[i] + force_[i];
-      dBodySetLinearVel(bodies_[i], v.x, v.y, v.z);
-    }
-  }
+  // seed 000 Eqs. 1-4 (keypoint_coupling.h, as in the XPBD backend): the bodies of the nodes
+  // it moved take their new velocities.
+  const auto moved = coupling_.apply_rt(keypoints(), keypoint_stencils(), keypoint_gain_, dts, x_, v_, pinned_);
+  for (const std::int32_t i : moved) dBodySetLinearVel(bodies_[i], v_[i].x, v_[i].y, v_[i].z);
   for (int i = 0; i < n; ++i) prev_[i] = x_[i];
   dWorldQuickStep(ode_world_, dts);
   read_bodies();

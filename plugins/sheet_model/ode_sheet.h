@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "contacts.h"
+#include "keypoint_coupling.h"
 #include "sheet_model.h"
 
 struct dxWorld;
@@ -40,7 +41,8 @@ class OdeSheet final : public SheetModel {
   std::vector<dxBody*> bodies_;
   std::vector<dxJoint*> joints_;
   std::vector<Vec3> x_, v_, prev_, force_;
-  std::vector<double> w_, kweight_;
+  std::vector<double> w_;
+  KeypointCoupling coupling_;  // seed 000 Eqs. 1-4, applied before every ODE step
   std::uint64_t synced_version_ = ~std::uint64_t{0};
   double synced_dt_ = 0;
   int steps_per_frame_ = 5;

@@ -46,8 +46,8 @@ struct SheetPointStencil {
 
 class SheetModel {
  public:
-  static constexpr int kMaxKeypoints = 1024;
   static constexpr int kMaxTargets = 4096;
+  static constexpr int kMaxKeypoints = kMaxTargets;  // either coupling takes as many observations
 
   explicit SheetModel(const SheetParams& params);  // throws std::invalid_argument
   virtual ~SheetModel() = default;
@@ -119,6 +119,13 @@ class SheetModel {
   void restore_links_rt() noexcept;
 
  protected:
+  // The accepted key-points and their stencils (what the backends' KeypointCoupling reads).
+  [[nodiscard]] std::span<const KeypointObs> keypoints() const noexcept {
+    return {keypoints_.data(), static_cast<std::size_t>(n_keypoints_)};
+  }
+  [[nodiscard]] std::span<const SheetPointStencil> keypoint_stencils() const noexcept {
+    return {keypoint_stencil_.data(), static_cast<std::size_t>(n_keypoints_)};
+  }
   void restore_link_stiffness() noexcept;  // default stiffness, then every crease applied
   [[nodiscard]] double link_base_compliance(int link) const noexcept;
 

@@ -60,8 +60,7 @@ XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
   v_.assign(n, Vec3{});
   prev_ = flat_;
   x_detect_ = flat_;
-  kvel_.assign(n, Vec3{});
-  kweight_.assign(n, 0.0);
+  coupling_.configure(n);
   w_.assign(n, 0.0);
   target_rows_.resize(kMaxTargets);
   kernel_.configure(topo_);
@@ -100,34 +99,6 @@ void XpbdSheet::prepare_frame(double dt_s) noexcept {
     const double den = wa + wb + compliance_[k] * inv_dts2;
     const double inv = den > 0 ? 1.0 / den : 0.0;
     kernel_.set_link(k, rest_[k] + plastic_[k], wa * inv, wb * inv);
-  }
-}
-
-// seed 000 Eqs. 1-3: v_l = lambda (k^w - c^w(k^m)); node velocity targets alpha_q v_l,
-// accumulated over key-points. A node with total influence W >= 1 takes the accumulated
-// velocity (Eq. 4 when k^m is a node); below 1 it keeps (1 - W) of its own velocity.
-void XpbdSheet::apply_keypoint_velocities(double dt_s) noexcept {
-  if (n_keypoints_ == 0) return;
-  // A gain above 1/dt_s would overshoot the key-point within one substep.
-  const double lambda = std::min(keypoint_gain_, 1.0 / dt_s);
-  if (!(lambda > 0)) return;
-  for (int l = 0; l < n_keypoints_; ++l) {
-    const SheetPointStencil& s = keypoint_stencil_[l];
-    Vec3 c;
-    for (int e = 0; e < 4; ++e) c += s.bilinear[e] * x_[s.node[e]];
-    const Vec3 vl = lambda * (keypoints_[l].world_mm - c);
-    for (int e = 0; e < 4; ++e) {
-      if (s.alpha[e] <= 0) continue;
-      kvel_[s.node[e]] += s.alpha[e] * vl;
-      kweight_[s.node[e]] += s.alpha[e];
-    }
-  }
-  for (int i = 0; i < node_count(); ++i) {
-    if (kweight_[i] > 0) {
-      v_[i] = (1.0 - std::min(kweight_[i], 1.0)) * v_[i] + kvel_[i];
-      kvel_[i] = Vec3{};
-      kweight_[i] = 0.0;
-    }
   }
 }
 
@@ -228,7 +199,8 @@ void XpbdSheet::step_rt(double dt) noexcept {
   const double damp = std::max(0.0, 1.0 - sp.damping_per_s * dts);
   const double vcap = sp.max_speed_mm_per_s;
   for (int s = 0; s < ns; ++s) {
-    apply_keypoint_velocities(dts);
+    // seed 000 Eqs. 1-4 (keypoint_coupling.h)
+    (void)coupling_.apply_rt(keypoints(), keypoint_stencils(), keypoint_gain_, dts, x_, v_, pinned_);
     predict_rt(x_, v_, prev_, pin_pos_, keep_, sp.gravity_mm_per_s2, damp, dts, simd_);  // seed 001 Eq. 1
     project_links();
     project_targets();

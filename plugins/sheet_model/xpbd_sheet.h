@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "contacts.h"
+#include "keypoint_coupling.h"
 #include "link_kernel.h"
 #include "sheet_model.h"
 
@@ -46,15 +47,14 @@ class XpbdSheet final : public SheetModel {
 
  private:
   void prepare_frame(double dt_s) noexcept;
-  void apply_keypoint_velocities(double dt_s) noexcept;
   void project_links() noexcept;
   void prepare_targets(double dt_s) noexcept;
   void project_targets() noexcept;
   void update_plasticity() noexcept;
   void detect_contacts(double dt_s) noexcept;
 
-  std::vector<Vec3> x_, v_, prev_, kvel_;
-  std::vector<double> kweight_;
+  std::vector<Vec3> x_, v_, prev_;
+  KeypointCoupling coupling_;  // seed 000 Eqs. 1-4, applied every substep
   std::vector<double> w_;  // inverse mass, 0 for pinned nodes, 1/kg
   struct TargetRow {        // one zero-length target spring, fixed within a frame
     std::int32_t node[4];
