@@ -8,10 +8,14 @@
 // (positions and link state) and the update returns degraded (counted in
 // sheet_state.rollbacks).
 // Parameters (all optional): nodes_u, nodes_v, width_mm, height_mm, density_g_per_m2,
-// thickness_mm, origin_x_mm, origin_y_mm, origin_z_mm, substeps, keypoint_gain_per_s, target_compliance_m_per_n,
+// thickness_mm, origin_x_mm, origin_y_mm, origin_z_mm, substeps,
+// coupling (how the key-points pull the model: `springs` (default), seed 001's zero-length
+// springs of compliance target_compliance_m_per_n; or `keypoints`, seed 000's node-velocity
+// P-controller of gain keypoint_gain_per_s), keypoint_gain_per_s, target_compliance_m_per_n,
 // compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
 // self_collision (0/1), self_collision_every (1..100 substeps; the last substep always).
 #include <memory>
+#include <string>
 
 #include "core/plugin.h"
 #include "core/port_types/keypoints.h"
@@ -38,6 +42,9 @@ class SheetModelPlugin final : public Plugin {
     sp.grid.origin_mm = {p.get<double>("origin_x_mm", 0.0), p.get<double>("origin_y_mm", sp.grid.height_mm),
                          p.get<double>("origin_z_mm", 0.5 * sp.grid.thickness_mm)};
     sp.solver.substeps = p.get_in_range<int>("substeps", 10, 1, 100);
+    const std::string coupling = p.get<std::string>("coupling", "springs");
+    if (!sheet::parse_coupling(coupling, sp.solver.coupling))
+      p.fail("coupling", "must be springs or keypoints, not '" + coupling + "'");
     sp.solver.keypoint_gain_per_s = p.get_in_range<double>("keypoint_gain_per_s", 10.0, 0.0, 1e6);
     sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);

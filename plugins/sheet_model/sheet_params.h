@@ -2,6 +2,8 @@
 // Internal units: positions mm, time s, mass kg; hence force mN and compliance mm/mN = m/N.
 #pragma once
 
+#include <string_view>
+
 #include "vec3.h"
 
 namespace crease::sheet {
@@ -30,6 +32,24 @@ struct TopologyParams {
   int bend_max_city = 8;
 };
 
+// The observed key-points pull the model through
+//   springs:   seed 001 Eq. 4, a zero-length spring per key-point (SheetModel::set_targets,
+//              compliance target_compliance_m_per_n), solved with the links every substep;
+//   keypoints: seed 000 Eqs. 1-4, a P-controller on the velocities of the nodes around each
+//              key-point (SheetModel::set_keypoints, gain keypoint_gain_per_s), every substep.
+enum class Coupling { springs, keypoints };
+
+[[nodiscard]] constexpr std::string_view coupling_name(Coupling c) noexcept {
+  return c == Coupling::keypoints ? "keypoints" : "springs";
+}
+// Parses "springs" or "keypoints"; false (out untouched) for anything else.
+[[nodiscard]] constexpr bool parse_coupling(std::string_view s, Coupling& out) noexcept {
+  if (s == "springs") out = Coupling::springs;
+  else if (s == "keypoints") out = Coupling::keypoints;
+  else return false;
+  return true;
+}
+
 struct SolverParams {
   int substeps = 10;                          // N_s (seed 001 Eq. 1: dt_s = dt / N_s)
   Vec3 gravity_mm_per_s2{0.0, 0.0, -9810.0};
@@ -44,6 +64,9 @@ struct SolverParams {
   double yield_strain = 0.0;       // eps_Y
   double plasticity_rate = 0.0;    // a in [0, 1)
   bool plastic_bending_only = true;
+  // How SheetRunner couples the observed key-points to the model (the model applies whatever
+  // inputs it is given): see Coupling.
+  Coupling coupling = Coupling::springs;
   // Key-point velocity coupling (seed 000 Eqs. 1-4): gain lambda, 1/s.
   double keypoint_gain_per_s = 10.0;
   // Zero-length target springs (seed 001 Eq. 4): alpha_input, m/N.

@@ -12,12 +12,13 @@ SheetRunner::SheetRunner(const SheetParams& params, double table_height_mm)
     : SheetRunner(std::make_unique<XpbdSheet>(params), table_height_mm) {}
 
 SheetRunner::SheetRunner(std::unique_ptr<SheetModel> model, double table_height_mm)
-    : model_(std::move(model)), predictor_(kMarkerIds * 5) {
+    : model_(std::move(model)), predictor_(kMarkerIds * 5), coupling_(model_->params().solver.coupling) {
   if (std::isfinite(table_height_mm)) {
     world_.add_table(table_height_mm);
     model_->set_collision_world(&world_);
   }
   predicted_.resize(SheetModel::kMaxTargets);
+  keypoint_obs_.resize(SheetModel::kMaxKeypoints);
   external_.resize(TargetPoints::kCapacity);
   last_good_.assign(model_->positions().begin(), model_->positions().end());
   normals_.resize(model_->node_count());
@@ -82,10 +83,19 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
     epoch_ns_ = now_ns;
     have_epoch_ = true;
   }
-  int n = predictor_.predict(seconds(now_ns), predicted_);
-  observations_ = static_cast<std::uint32_t>(n);
+  const int n_obs = predictor_.predict(seconds(now_ns), predicted_);
+  observations_ = static_cast<std::uint32_t>(n_obs);
+  int n = n_obs;
   for (int i = 0; i < n_external_ && n < static_cast<int>(predicted_.size()); ++i) predicted_[n++] = external_[i];
-  model_->set_targets(std::span<const TargetPoint>(predicted_.data(), n));
+  const std::span<const TargetPoint> all(predicted_.data(), static_cast<std::size_t>(n));
+  if (coupling_ == Coupling::keypoints) {
+    const int k = std::min(n_obs, static_cast<int>(keypoint_obs_.size()));
+    for (int i = 0; i < k; ++i) keypoint_obs_[i] = {predicted_[i].world_mm, predicted_[i].sheet_mm};
+    model_->set_keypoints(std::span<const KeypointObs>(keypoint_obs_.data(), static_cast<std::size_t>(k)));
+    model_->set_targets(all.subspan(static_cast<std::size_t>(n_obs)));
+  } else {
+    model_->set_targets(all);
+  }
   model_->save_links_rt();  // with last_good_: the state this step starts from
   model_->step_rt(dt_s);
   ++steps_;

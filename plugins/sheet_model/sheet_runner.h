@@ -1,6 +1,8 @@
 // The sheet model as one loop step, independent of the plugin ABI (the plugin wrapper is a
 // thin shell around this; tests drive it directly): observations and model edits in, a
-// SheetState out. A step that leaves the state non-finite is rolled back to the state it
+// SheetState out. The observed key-points, predicted to the step's time, pull the model
+// through the coupling of params().solver.coupling: zero-length springs (seed 001 Eq. 4) or
+// key-point velocities (seed 000 Eqs. 1-4); target points (set_targets) are springs either way. A step that leaves the state non-finite is rolled back to the state it
 // started from (positions, zero velocities, rest lengths, plastic elongations, stiffnesses,
 // creases) and reported, never propagated. Everything is allocated in the constructor.
 #pragma once
@@ -39,6 +41,7 @@ class SheetRunner {
   bool step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noexcept;
 
   [[nodiscard]] SheetModel& model() noexcept { return *model_; }
+  [[nodiscard]] Coupling coupling() const noexcept { return coupling_; }
   [[nodiscard]] std::uint32_t rollbacks() const noexcept { return rollbacks_; }
 
  private:
@@ -50,7 +53,9 @@ class SheetRunner {
   CollisionWorld world_;
   std::unique_ptr<SheetModel> model_;
   KeypointPredictor predictor_;
+  Coupling coupling_;
   std::vector<TargetPoint> predicted_;  // predictor output plus target_points, capacity fixed
+  std::vector<KeypointObs> keypoint_obs_;  // the predicted key-points for set_keypoints
   std::vector<TargetPoint> external_;
   int n_external_ = 0;
   std::vector<Vec3> last_good_, normals_;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <map>
+#include <string>
 
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
@@ -35,6 +36,21 @@ void run_cycles(crease::PluginHost& host, double seconds, std::int64_t& now_ns, 
 
 TEST_CASE("config/sim.yaml: every plugin's steady-state cycles allocate nothing") {
   auto cfg = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/sim.yaml");
+  // The sheet model with each of its couplings (how the key-points pull it): as shipped
+  // (springs) and with the other one (tests/plugins/sheet_model/sheet_runner_test.cpp shows
+  // what each one does).
+  std::string coupling;
+  SUBCASE("as shipped") {}
+  SUBCASE("coupling: keypoints") { coupling = "keypoints"; }
+  if (!coupling.empty()) {
+    int sheets = 0;
+    for (auto& pc : cfg.plugins) {
+      if (pc.library != "sheet_model") continue;
+      pc.params["coupling"] = coupling;
+      ++sheets;
+    }
+    REQUIRE(sheets == 1);
+  }
   crease::daemon::Options opts;
   opts.plugin_dirs = {CREASE_PLUGIN_DIR};
   crease::daemon::Daemon daemon(std::move(cfg), opts);

@@ -7,8 +7,11 @@
 #include <thread>
 
 #include "core/plugin_host.h"
+#include "core/port_types/keypoints.h"
 #include "core/port_types/sheet_state.h"
+#include "plugins/sheet_model/synthetic_markers.h"
 #include "rt/alloc_guard.h"
+#include "rt/clock.h"
 
 using namespace std::chrono_literals;
 
@@ -79,4 +82,78 @@ TEST_CASE("self_collision_every is a validated parameter, named in the error") {
   CHECK_THROWS_WITH_AS(host.add_instance(spec("{substeps: 4, self_collision_every: 1000}")),
                        doctest::Contains("self_collision_every"), std::exception);
   CHECK_NOTHROW(host.add_instance(spec("{substeps: 4, self_collision_every: 1}")));
+}
+
+TEST_CASE("coupling is springs or keypoints, anything else an error naming the key") {
+  auto configure = [](const char* yaml) {  // one host each: the ports have one writer, one reader
+    crease::PluginHost host{{CREASE_PLUGIN_DIR}};
+    host.add_loop({"model", 120.0, 0, -1});
+    crease::InstanceSpec s;
+    s.name = "sheet";
+    s.library = "sheet_model";
+    s.loop = "model";
+    s.params = crease::Params(YAML::Load(yaml), "test.yaml", "sheet.params");
+    host.add_instance(s);
+  };
+  CHECK_THROWS_WITH_AS(configure("{substeps: 4, coupling: velocities}"),
+                       doctest::Contains("sheet.params.coupling: must be springs or keypoints, not 'velocities'"),
+                       std::exception);
+  CHECK_THROWS_WITH_AS(configure("{substeps: 4, coupling: [springs]}"), doctest::Contains("coupling"),
+                       std::exception);
+  CHECK_NOTHROW(configure("{substeps: 4, coupling: springs}"));
+  CHECK_NOTHROW(configure("{substeps: 4, coupling: keypoints}"));
+}
+
+// The sheet's mean height after 60 model steps while a test writer keeps showing the
+// plugin the marker layout's key-points 40 mm above the flat sheet on the table.
+double mean_z_after_lift(const char* params) {
+  crease::PluginHost host{{CREASE_PLUGIN_DIR}};
+  host.add_loop({"model", 120.0, 0, -1});
+  crease::InstanceSpec s;
+  s.name = "sheet";
+  s.library = "sheet_model";
+  s.loop = "model";
+  s.params = crease::Params(YAML::Load(params), "test.yaml", "sheet.params");
+  host.add_instance(s);
+  auto* kp_port = host.ports().bind_latest_writer("keypoints", crease::port_type_of<crease::Keypoints>(), "test");
+  auto kp = std::make_unique<crease::Keypoints>();
+  const auto layout = crease::sheet::marker_keypoints(crease::sheet::MarkerLayout{});
+  kp->count = static_cast<std::uint32_t>(layout.size());
+  for (std::size_t i = 0; i < layout.size(); ++i) {
+    const auto& m = layout[i];  // flat sheet: (u, 297 - v, 0.5) in world mm
+    kp->points[i] = {{float(m.u), float(297.0 - m.v), 40.5f}, {float(m.u), float(m.v)}, 0.1f,
+                     static_cast<std::uint16_t>(i / 5), static_cast<std::uint8_t>(i % 5), 0, 3};
+  }
+  auto state = std::make_unique<crease::SheetState>();
+  const auto* out = host.ports().find_latest("sheet_state");
+  REQUIRE(out != nullptr);
+  host.start();
+  bool done = false;
+  for (int i = 0; i < 5000 && !done; ++i) {  // a fresh observation every poll: never stale
+    kp->timestamp_ns = crease::rt::now_ns();
+    ++kp->frame;
+    kp_port->write(kp.get(), kp->timestamp_ns);
+    host.poll();
+    done = out->read(state.get(), 0).has_data() && state->step > 60;
+    std::this_thread::sleep_for(1ms);
+  }
+  host.stop();
+  REQUIRE(done);
+  CHECK(state->all_finite());
+  CHECK(state->observations == layout.size());
+  double z = 0;
+  const int n = state->nodes_u * state->nodes_v;
+  for (int k = 0; k < n; ++k) z += state->position_mm[k][2];
+  return z / n;
+}
+
+TEST_CASE("the coupling parameter reaches the model: springs, or key-point velocities of gain keypoint_gain_per_s") {
+  const double springs = mean_z_after_lift("{substeps: 4, coupling: springs, keypoint_gain_per_s: 0}");
+  const double keypoints = mean_z_after_lift("{substeps: 4, coupling: keypoints, keypoint_gain_per_s: 10}");
+  const double keypoints_no_gain = mean_z_after_lift("{substeps: 4, coupling: keypoints, keypoint_gain_per_s: 0}");
+  MESSAGE("mean height: springs " << springs << " mm, keypoints " << keypoints << " mm, keypoints at gain 0 "
+                                  << keypoints_no_gain << " mm");
+  CHECK(springs > 30.0);                // the springs lift it whatever the gain
+  CHECK(keypoints > 20.0);              // lambda = 10/s: a 0.1 s time constant, 0.5 s here
+  CHECK(keypoints_no_gain < 1.0);       // no pull at all: it stays on the table (0.5 mm)
 }
