@@ -1,11 +1,12 @@
 // crease-bench sheet: the sheet model's time per 1/60 s frame and its tracking of the
 // analytic half fold, beside Bullet's soft body (same nodes, links, masses, frame and
-// iterations) and the ODE backend, measured in the same run.
+// iterations) and the ODE backend, measured in the same run; ours and the ODE backend with
+// each coupling of the key-points (springs: seed 001 Eq. 4; keypoints: seed 000 Eqs. 1-4).
 //
 // Tracking: 35 markers x 5 key-points observed at 15 Hz with 0.3 mm noise (fixed seed);
 // runs: all key-points; 30 % dropped per vision frame plus the flap (v < h/2) hidden for
 // 1 s. Error: mean distance of every node to the analytic fold, every frame.
-// Time: ours and Bullet take --repeats turns each (default 5), alternating. In a turn an
+// Time: ours (springs), Bullet and ours (keypoints) take --repeats turns each (default 5), in turn. In a turn an
 // engine tracks the fold from a fresh start again and again until it has stepped for at least
 // --turn-s seconds (default 0.5: one Bullet run, ~10 of ours), so both are timed over windows
 // of the same length on this shared machine; a turn's figure is its step time over its frames,
@@ -100,22 +101,34 @@ TrackResult track(Engine& e, const FoldScript& truth, const std::vector<Vec2>& k
   return r;
 }
 
-// A Crease sheet on the table with a crease on the fold line, targets set every frame, one
-// step_rt per 1/60 s frame. Ours: XPBD, seed 000 topology, self-collision, targets as zero-length
-// springs (seed 001 Eq. 4) (XpbdSheet); the ODE backend: the same model from ODE bodies and soft
-// distance joints (OdeSheet).
+// A Crease sheet on the table with a crease on the fold line, key-points set every frame, one
+// step_rt per 1/60 s frame. Ours: XPBD, seed 000 topology, self-collision (XpbdSheet); the ODE
+// backend: the same model from ODE bodies and soft distance joints (OdeSheet). The key-points
+// pull it as SheetRunner does with p.solver.coupling: zero-length springs (seed 001 Eq. 4,
+// set_targets) or node velocities (seed 000 Eqs. 1-4, gain keypoint_gain_per_s, set_keypoints).
 template <class Sheet>
 struct CreaseEngine {
   CollisionWorld world;
   std::unique_ptr<Sheet> s;
-  explicit CreaseEngine(const SheetParams& p) {
+  Coupling coupling;
+  std::vector<KeypointObs> obs;
+  explicit CreaseEngine(const SheetParams& p) : coupling(p.solver.coupling) {
     world.add_table(0.0);
     s = std::make_unique<Sheet>(p);
     s->set_collision_world(&world);
     s->add_crease({{0, p.grid.height_mm / 2}, {p.grid.width_mm, p.grid.height_mm / 2}});
+    obs.reserve(SheetModel::kMaxKeypoints);
   }
   Engine engine() {
-    return {[this](std::span<const TargetPoint> t) { s->set_targets(t); },
+    return {[this](std::span<const TargetPoint> t) {
+              if (coupling == Coupling::springs) {
+                s->set_targets(t);
+                return;
+              }
+              obs.clear();
+              for (const TargetPoint& k : t) obs.push_back({k.world_mm, k.sheet_mm});
+              s->set_keypoints(obs);
+            },
             [this] { s->step_rt(kFrame); },
             [this](std::vector<Vec3>& x) { x.assign(s->positions().begin(), s->positions().end()); }};
   }
@@ -255,10 +268,13 @@ int run_sheet(int argc, char** argv) {
   const std::vector<Vec2> kps = marker_keypoints(MarkerLayout{});
   const int nodes = p.grid.nodes_u * p.grid.nodes_v;
 
+  p.solver.coupling = Coupling::springs;
+  SheetParams pk = p;  // the same sheet, pulled by seed 000's key-point velocities
+  pk.solver.coupling = Coupling::keypoints;
   Ours ours(p);  // for the counts
-  TrackResult o, b;
-  std::vector<double> ours_us, bullet_us;
-  std::vector<int> ours_runs, bullet_runs;
+  TrackResult o, b, k;
+  std::vector<double> ours_us, bullet_us, kp_us;
+  std::vector<int> ours_runs, bullet_runs, kp_runs;
   // One turn: fresh runs until turn_s of stepping; returns us per frame over the turn.
   auto turn = [&](auto make, TrackResult& first, std::vector<int>& runs) {
     double us = 0, stepped_s = 0;
@@ -278,45 +294,55 @@ int run_sheet(int argc, char** argv) {
   for (int r = 0; r < repeats; ++r) {
     ours_us.push_back(turn([&] { return std::make_unique<Ours>(p); }, o, ours_runs));
     bullet_us.push_back(turn([&] { return std::make_unique<BulletSheet>(p); }, b, bullet_runs));
+    kp_us.push_back(turn([&] { return std::make_unique<Ours>(pk); }, k, kp_runs));
   }
   o.us_per_frame = median_of(ours_us);
   b.us_per_frame = median_of(bullet_us);
-  Ours ours_d(p);
-  auto e1d = ours_d.engine();
+  k.us_per_frame = median_of(kp_us);
+  Ours ours_d(p), ours_kd(pk);
+  auto e1d = ours_d.engine(), e1kd = ours_kd.engine();
   const TrackResult od = track(e1d, truth, kps, true, nodes);
+  const TrackResult kd = track(e1kd, truth, kps, true, nodes);
   BulletSheet bullet_d(p);
   auto e2d = bullet_d.engine();
   const TrackResult bd = track(e2d, truth, kps, true, nodes);
-  OdeEngine ode(p), ode_d(p);
-  auto e3 = ode.engine(), e3d = ode_d.engine();
+  OdeEngine ode(p), ode_d(p), ode_k(pk), ode_kd(pk);
+  auto e3 = ode.engine(), e3d = ode_d.engine(), e3k = ode_k.engine(), e3kd = ode_kd.engine();
   const TrackResult od3 = track(e3, truth, kps, false, nodes);
   const TrackResult od3d = track(e3d, truth, kps, true, nodes);
+  const TrackResult od3k = track(e3k, truth, kps, false, nodes);
+  const TrackResult od3kd = track(e3kd, truth, kps, true, nodes);
 
   std::printf("sheet: %dx%d nodes, %d links (%d structural, %d bending), %d substeps, table + self-collision\n",
               p.grid.nodes_u, p.grid.nodes_v, ours.s->link_count(), ours.s->topology().structural_count,
               ours.s->topology().bending_count, p.solver.substeps);
   std::printf("half fold 0->175 deg in 5 s, hold 3 s; %zu key-points at 15 Hz, 0.3 mm noise\n", kps.size());
+  std::printf("coupling: springs (seed 001 Eq. 4, %.0e m/N) or keypoints (seed 000 Eqs. 1-4, lambda %.1f/s)\n",
+              p.solver.target_compliance_m_per_n, pk.solver.keypoint_gain_per_s);
   auto runs = [](const char* name, const std::vector<double>& us, const std::vector<int>& n) {
     std::printf("%s us/frame per turn (runs):", name);
     for (std::size_t k = 0; k < us.size(); ++k) std::printf(" %.1f (%d)", us[k], n[k]);
     std::printf(", median %.1f\n", median_of(us));
   };
-  runs("ours  ", ours_us, ours_runs);
-  runs("bullet", bullet_us, bullet_runs);
-  std::printf("%-28s %12s %10s %10s %14s %12s\n", "engine", "us/frame", "err_mm", "end_mm", "dropout_err_mm", "max_jump_mm");
+  runs("ours springs  ", ours_us, ours_runs);
+  runs("bullet        ", bullet_us, bullet_runs);
+  runs("ours keypoints", kp_us, kp_runs);
+  std::printf("%-30s %12s %10s %10s %14s %12s\n", "engine", "us/frame", "err_mm", "end_mm", "dropout_err_mm", "max_jump_mm");
   auto row = [](const char* name, const TrackResult& a, const TrackResult& d) {
-    std::printf("%-28s %12.1f %10.2f %10.2f %14.2f %12.2f\n", name, a.us_per_frame, a.mean_err_mm, a.end_err_mm,
+    std::printf("%-30s %12.1f %10.2f %10.2f %14.2f %12.2f\n", name, a.us_per_frame, a.mean_err_mm, a.end_err_mm,
                 d.mean_err_mm, std::max(a.max_jump_mm, d.max_jump_mm));
   };
-  row("xpbd (ours)", o, od);
+  row("xpbd springs (ours)", o, od);
+  row("xpbd keypoints (ours)", k, kd);
   row("bullet soft body (ICL)", b, bd);
-  row("ode backend (5 steps/frame)", od3, od3d);
+  row("ode springs (5 steps/frame)", od3, od3d);
+  row("ode keypoints (5 steps/frame)", od3k, od3kd);
   const double speedup = b.us_per_frame / o.us_per_frame;
   std::printf("speedup over bullet %.2fx, over the ode backend %.2fx\n", speedup, od3.us_per_frame / o.us_per_frame);
   std::printf("sheet: links=%d ours_us_per_frame=%.1f bullet_us_per_frame=%.1f speedup=%.2f err_mm=%.2f "
-              "err_dropout_mm=%.2f max_jump_mm=%.2f\n",
+              "err_dropout_mm=%.2f max_jump_mm=%.2f err_keypoints_mm=%.2f keypoints_us_per_frame=%.1f\n",
               ours.s->link_count(), o.us_per_frame, b.us_per_frame, speedup, o.mean_err_mm, od.mean_err_mm,
-              std::max(o.max_jump_mm, od.max_jump_mm));
+              std::max(o.max_jump_mm, od.max_jump_mm), k.mean_err_mm, k.us_per_frame);
   return 0;
 }
 
