@@ -1,6 +1,8 @@
 // The parameters every CAN driver plugin shares, read from its configuration (non-RT):
 //   bus_kind   mock | socketcan (default mock)
 //   bus        the mocked bus name or the SocketCAN interface (required)
+//   bus_prefix mock only: the bus is `<bus_prefix>-<bus>`, "auto" the daemon's own prefix
+//              (bus_prefix.h); absent: `bus` is the whole name
 //   host_node  this controller's node id on a mocked bus (default 100)
 //   timeout_cycles, crc_threshold   the link monitor (LinkMonitorConfig)
 // Errors throw ConfigError naming the file, line and key (crease::Params).

@@ -4,8 +4,9 @@
 // (node 11). Everything is created and started in configure (non-RT) and stopped in cleanup;
 // the device threads run beside the loops like firmware beside a PC. update does nothing.
 // The buses are named `<bus_prefix>-hand_r`, `-hand_l`, `-arm_r`, `-arm_l` (abstract AF_UNIX
-// names: one simulated robot per machine and prefix). List it before the driver plugins.
-// Parameters: bus_prefix (default "crease-sim"), bitrate, data_bitrate.
+// names: one simulated robot per prefix on a machine). List it before the driver plugins.
+// Parameters: bus_prefix (default "auto": this daemon's own, drivers/host/bus_prefix.h; the
+// drivers say `bus_prefix: auto` too), bitrate, data_bitrate.
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "core/plugin.h"
 #include "drivers/can/mock_can_broker.h"
 #include "drivers/can/mock_can_bus.h"
+#include "drivers/host/bus_prefix.h"
 #include "drivers/simdevice/device_thread.h"
 #include "drivers/simdevice/sim_arm.h"
 #include "drivers/simdevice/sim_hand.h"
@@ -25,12 +27,12 @@ namespace dr = crease::drivers;
 class SimDevices final : public Plugin {
  public:
   void configure(const Params& p, PortBinder&) override {
-    const std::string prefix = p.get<std::string>("bus_prefix", "crease-sim");
+    const std::string prefix = *dr::bus_prefix_from_params(p, std::string(dr::kAutoBusPrefix));
     const auto bitrate = static_cast<std::uint32_t>(p.get_in_range<int>("bitrate", 1'000'000, 10'000, 1'000'000));
     const auto data_bitrate =
         static_cast<std::uint32_t>(p.get_in_range<int>("data_bitrate", 5'000'000, 10'000, 8'000'000));
     auto bus = [&](const char* name, std::uint32_t node) {
-      const std::string full = prefix + "-" + name;
+      const std::string full = dr::prefixed_bus(prefix, name);
       try {
         brokers_.push_back(std::make_unique<dr::MockCanBroker>(dr::MockCanBrokerConfig{full, bitrate, data_bitrate, false}));
         buses_.push_back(std::make_unique<dr::MockCanBus>(dr::MockCanBusConfig{full, node, bitrate, data_bitrate}));
