@@ -70,6 +70,26 @@ Params Params::child(std::string_view key) const {
   return p;
 }
 
+std::vector<Params> Params::list(std::string_view key) const {
+  const YAML::Node n = lookup(key, false);
+  used_->insert("list:" + path_ + "." + std::string(key));  // unused_keys() looks inside
+  std::vector<Params> out;
+  if (!n) return out;
+  if (!n.IsSequence()) fail(key, "expected a list of maps");
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string path = path_ + "." + std::string(key) + "[" + std::to_string(i) + "]";
+    if (!n[i].IsMap()) {
+      Params at(YAML::Node(YAML::NodeType::Map), file_, path);
+      at.node_ = n[i];
+      at.fail({}, "expected a map");
+    }
+    Params p(n[i], file_, path);
+    p.used_ = used_;
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 YAML::Node Params::raw(std::string_view key) const { return lookup(key, false); }
 
 std::vector<std::string> Params::unused_keys() const {
@@ -84,6 +104,14 @@ std::vector<std::string> Params::unused_keys() const {
       // plugin's to check.)
       if (used_->count("child:" + full)) {
         Params c(kv.second, file_, full);
+        c.used_ = used_;
+        for (auto& s : c.unused_keys()) out.push_back(std::move(s));
+      }
+    } else if (kv.second.IsSequence() && used_->count("list:" + full)) {
+      // A list read with list(): the keys of its maps must be read too.
+      for (std::size_t i = 0; i < kv.second.size(); ++i) {
+        if (!kv.second[i].IsMap()) continue;
+        Params c(kv.second[i], file_, full + "[" + std::to_string(i) + "]");
         c.used_ = used_;
         for (auto& s : c.unused_keys()) out.push_back(std::move(s));
       }

@@ -54,6 +54,9 @@ class Params {
 
   // A nested map (throws when present but not a map; empty when absent).
   [[nodiscard]] Params child(std::string_view key) const;
+  // A list of maps, each element a Params named `key[i]` (throws when present but not a list of
+  // maps; empty when absent). unused_keys() looks inside the elements.
+  [[nodiscard]] std::vector<Params> list(std::string_view key) const;
   // The raw node, for lists and structures a plugin parses itself (use where() in messages).
   [[nodiscard]] YAML::Node raw(std::string_view key) const;
 

@@ -28,6 +28,15 @@ rt::LatestChannel* PortBinder::add_latest_output(std::string_view port, const Po
   return ch;
 }
 
+std::optional<PortInfo> PortBinder::find(std::string_view port) const {
+  const auto it = remap_.find(std::string(port));
+  const std::string global = it == remap_.end() ? std::string(port) : it->second;
+  for (PortInfo& info : registry_.list()) {
+    if (info.name == global) return std::move(info);
+  }
+  return std::nullopt;
+}
+
 void PortBinder::tunable(std::string_view key, double* value, double lo, double hi) {
   const std::string k(key);
   if (value == nullptr || !(lo <= hi)) throw ConfigError("instance '" + instance_ + "': tunable '" + k + "' needs a target and lo <= hi");

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,6 +64,10 @@ class PortBinder {
   // between two updates, on the loop thread, after validate_param() accepted it and it lies in
   // [lo, hi]. The current *value is the initial one.
   void tunable(std::string_view key, double* value, double lo, double hi);
+
+  // The port `port` (after remapping) as some instance already bound it, for a plugin whose
+  // port types come from its configuration (a bridge); nullopt when nothing bound it yet.
+  [[nodiscard]] std::optional<PortInfo> find(std::string_view port) const;
 
   [[nodiscard]] const std::string& instance() const noexcept { return instance_; }
   [[nodiscard]] rt::RtLogQueue* log_queue() const noexcept { return log_; }

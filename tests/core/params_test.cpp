@@ -50,6 +50,24 @@ TEST_CASE("keys never read are reported, including inside opened child maps") {
   CHECK(unused[1] == "sim.yaml:5:6: plugins[0].params.sub.b");
 }
 
+TEST_CASE("a list of maps: each element named by its index, its unread keys reported") {
+  const auto p = parse("links:\n  - {port: a, topic: x}\n  - {port: b, tpoic: y}\nnot_list: 3\nbad: [1]\n");
+  const auto links = p.list("links");
+  REQUIRE(links.size() == 2);
+  CHECK(links[0].get<std::string>("port") == "a");
+  (void)links[0].get<std::string>("topic");
+  CHECK(links[1].get<std::string>("port") == "b");
+  CHECK(error_of([&] { (void)links[1].get<std::string>("topic"); }) ==
+        "sim.yaml:3:5: plugins[0].params.links[1].topic: required parameter is missing");
+  const auto unused = p.unused_keys();
+  REQUIRE(unused.size() == 3);
+  CHECK(unused[0] == "sim.yaml:3:22: plugins[0].params.links[1].tpoic");
+  CHECK(p.list("absent").empty());
+  CHECK(error_of([&] { (void)p.list("not_list"); }) ==
+        "sim.yaml:4:11: plugins[0].params.not_list: expected a list of maps");
+  CHECK(error_of([&] { (void)p.list("bad"); }) == "sim.yaml:5:7: plugins[0].params.bad[0]: expected a map");
+}
+
 TEST_CASE("a non-map is refused") {
   CHECK(error_of([] { parse("[1, 2]"); }).find("expected a map of parameters") != std::string::npos);
 }
