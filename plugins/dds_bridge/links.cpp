@@ -1,0 +1,100 @@
+#include "links.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "participant.h"
+
+namespace crease::dds_bridge {
+
+Endpoint::Endpoint(dds_entity_t participant, const dds_topic_descriptor_t* type, const std::string& topic,
+                   const TopicQos& qos, bool writer) {
+  const QosPtr q = make_qos(qos);
+  topic_ = dds_create_topic(participant, type, topic.c_str(), q.get(), nullptr);
+  if (topic_ < 0)
+    throw ParamError("topic", "DDS refused topic " + topic + " of type " + type->m_typename + ": " +
+                                  dds_strretcode(topic_));
+  endpoint_ = writer ? dds_create_writer(participant, topic_, q.get(), nullptr)
+                     : dds_create_reader(participant, topic_, q.get(), nullptr);
+  if (endpoint_ < 0) {
+    const std::string why = dds_strretcode(endpoint_);
+    dds_delete(topic_);
+    throw ParamError("topic", std::string("DDS refused a ") + (writer ? "writer" : "reader") + " of " + topic +
+                                  " with this QoS: " + why);
+  }
+}
+
+Endpoint::~Endpoint() {
+  dds_delete(endpoint_);
+  dds_delete(topic_);
+}
+
+void Link::stats_rt(BridgeTopicStats& out) const noexcept {
+  const auto get = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+  const LinkCounters& c = counters_;
+  out.direction = direction_;
+  out.stale = direction_ == BridgeTopicStats::subscribe && c.stale.load(std::memory_order_acquire) ? 1 : 0;
+  out.matched = static_cast<std::uint16_t>(std::min<std::uint32_t>(c.matched.load(std::memory_order_relaxed), 0xffff));
+  out.samples = get(c.samples);
+  out.port_writes = port_writes_;
+  out.overwritten = get(c.overwritten);
+  out.lost = get(c.lost);
+  out.rejected = get(c.rejected);
+  out.malformed = get(c.malformed);
+  out.oversized = get(c.oversized);
+  out.undecodable = get(c.undecodable);
+  out.deadline_missed = get(c.deadline_missed);
+  out.liveliness_lost = get(c.liveliness_lost);
+  out.incompatible_qos = get(c.incompatible_qos);
+}
+
+void take_reader_statuses(dds_entity_t reader, LinkCounters& c) {
+  std::uint32_t st = 0;
+  if (dds_take_status(reader, &st, DDS_LIVELINESS_CHANGED_STATUS | DDS_REQUESTED_DEADLINE_MISSED_STATUS |
+                                       DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS |
+                                       DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS | DDS_SUBSCRIPTION_MATCHED_STATUS) < 0)
+    return;
+  const auto add = [](std::atomic<std::uint64_t>& a, std::int64_t n) {
+    if (n > 0) a.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
+  };
+  if (st & DDS_LIVELINESS_CHANGED_STATUS) {
+    dds_liveliness_changed_status_t s;
+    if (dds_get_liveliness_changed_status(reader, &s) == 0) {
+      add(c.liveliness_lost, -static_cast<std::int64_t>(s.alive_count_change));
+      if (s.alive_count == 0) c.stale.store(true, std::memory_order_release);
+    }
+  }
+  if (st & DDS_REQUESTED_DEADLINE_MISSED_STATUS) {
+    dds_requested_deadline_missed_status_t s;
+    if (dds_get_requested_deadline_missed_status(reader, &s) == 0) {
+      add(c.deadline_missed, s.total_count_change);
+      c.stale.store(true, std::memory_order_release);
+    }
+  }
+  if (st & DDS_SAMPLE_LOST_STATUS) {
+    dds_sample_lost_status_t s;
+    if (dds_get_sample_lost_status(reader, &s) == 0) add(c.lost, s.total_count_change);
+  }
+  if (st & DDS_SAMPLE_REJECTED_STATUS) {
+    dds_sample_rejected_status_t s;
+    if (dds_get_sample_rejected_status(reader, &s) == 0) add(c.rejected, s.total_count_change);
+  }
+  if (st & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) {
+    dds_requested_incompatible_qos_status_t s;
+    if (dds_get_requested_incompatible_qos_status(reader, &s) == 0) add(c.incompatible_qos, s.total_count_change);
+  }
+  if (st & DDS_SUBSCRIPTION_MATCHED_STATUS) {
+    dds_subscription_matched_status_t s;
+    if (dds_get_subscription_matched_status(reader, &s) == 0) c.matched.store(s.current_count, std::memory_order_relaxed);
+  }
+}
+
+void take_writer_statuses(dds_entity_t writer, LinkCounters& c) {
+  dds_publication_matched_status_t m;
+  if (dds_get_publication_matched_status(writer, &m) == 0) c.matched.store(m.current_count, std::memory_order_relaxed);
+  dds_offered_incompatible_qos_status_t q;
+  if (dds_get_offered_incompatible_qos_status(writer, &q) == 0 && q.total_count_change > 0)
+    c.incompatible_qos.fetch_add(static_cast<std::uint64_t>(q.total_count_change), std::memory_order_relaxed);
+}
+
+}  // namespace crease::dds_bridge

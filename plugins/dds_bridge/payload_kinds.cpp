@@ -1,0 +1,52 @@
+#include "payload_kinds.h"
+
+#include <cstring>
+
+#include "hand_mirror.h"
+#include "keypoints_mirror.h"
+
+namespace crease::dds_bridge {
+
+namespace {
+
+template <class T>
+PayloadKind kind_of() {
+  using D = Dds<T>;
+  return PayloadKind{
+      D::kKey, port_type_of<T>(), D::descriptor()->m_typename,
+      [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
+         const TopicQos& qos) -> std::unique_ptr<PublishLink> {
+        return std::make_unique<PublishLinkT<T, D>>(ports, port, pp, topic, qos);
+      },
+      [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
+         const TopicQos& qos) -> std::unique_ptr<SubscribeLink> {
+        return std::make_unique<SubscribeLinkT<T, D>>(ports, port, pp, topic, qos);
+      }};
+}
+
+const PayloadKind kKinds[] = {kind_of<crease::Keypoints>(), kind_of<crease::HandState>(),
+                              kind_of<crease::HandCommand>()};
+
+}  // namespace
+
+std::span<const PayloadKind> payload_kinds() { return kKinds; }
+
+const PayloadKind* find_payload_kind(const std::string& key) {
+  for (const PayloadKind& k : kKinds)
+    if (key == k.key) return &k;
+  return nullptr;
+}
+
+const PayloadKind* find_payload_kind(const std::string& port_type, std::uint32_t version) {
+  for (const PayloadKind& k : kKinds)
+    if (port_type == k.port_type.name && version == k.port_type.version) return &k;
+  return nullptr;
+}
+
+std::string payload_kind_keys() {
+  std::string s;
+  for (const PayloadKind& k : kKinds) s += (s.empty() ? "" : ", ") + std::string(k.key);
+  return s;
+}
+
+}  // namespace crease::dds_bridge

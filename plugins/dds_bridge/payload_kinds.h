@@ -1,0 +1,37 @@
+// The port payloads a bridge can carry, each with its IDL type (idl/*.idl) and how to make a
+// publish or subscribe link for a port of it. Non-RT.
+//
+//   type          port payload          DDS type (ROS 2 name)
+//   keypoints     crease::Keypoints     crease_msgs::msg::dds_::Keypoints_   (crease_msgs/msg/Keypoints)
+//   hand_state    crease::HandState     crease_msgs::msg::dds_::HandState_   (crease_msgs/msg/HandState)
+//   hand_command  crease::HandCommand   crease_msgs::msg::dds_::HandCommand_ (crease_msgs/msg/HandCommand)
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+
+#include "core/port.h"
+#include "links.h"
+
+namespace crease::dds_bridge {
+
+struct PayloadKind {
+  const char* key;       // the entry's `type:`
+  PortType port_type;    // of the local port
+  const char* dds_type;  // the topic's type name on the wire
+  std::unique_ptr<PublishLink> (*make_publish)(PortBinder& ports, const std::string& port, dds_entity_t participant,
+                                               const std::string& topic, const TopicQos& qos);
+  std::unique_ptr<SubscribeLink> (*make_subscribe)(PortBinder& ports, const std::string& port,
+                                                   dds_entity_t participant, const std::string& topic,
+                                                   const TopicQos& qos);
+};
+
+[[nodiscard]] std::span<const PayloadKind> payload_kinds();
+// By `type:` key, or by the port's payload type name and version; nullptr when none.
+[[nodiscard]] const PayloadKind* find_payload_kind(const std::string& key);
+[[nodiscard]] const PayloadKind* find_payload_kind(const std::string& port_type, std::uint32_t version);
+// "keypoints, hand_state, hand_command" for messages.
+[[nodiscard]] std::string payload_kind_keys();
+
+}  // namespace crease::dds_bridge
