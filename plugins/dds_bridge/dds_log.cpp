@@ -41,7 +41,7 @@ void DdsLog::release() {
 
 void DdsLog::watch(const std::string& topic, const std::string& type_name, std::atomic<std::uint64_t>* counter) {
   const std::lock_guard lock(mu_);
-  watches_.push_back(Watch{" " + topic + "/" + type_name + " ", counter});
+  watches_.push_back(Watch{" " + topic + "/" + type_name + " ", " " + type_name + " failed in type conversion", counter});
 }
 
 void DdsLog::unwatch(const std::atomic<std::uint64_t>* counter) {
@@ -53,12 +53,14 @@ void DdsLog::on_message(const char* message, std::size_t size) {
   const std::string_view text(message, size);
   std::fwrite(message, 1, size, stderr);
   if (t_capture != nullptr) t_capture->text_.append(text);
-  // q_receive.c: "... deserialization <topic>/<type> failed (<why>)"; ddsi_endpoint.c (local
-  // delivery): "local: deserialization of <topic>/<type> as ... failed ...".
+  // From the network: "data(application, …): … deserialization <topic>/<type> failed (<why>)";
+  // inside the process: "local: deserialization of <topic>/<type> as …" or
+  // "local: deserialization <type> failed in type conversion".
   if (text.find("deserialization") == std::string_view::npos) return;
   const std::lock_guard lock(mu_);
   for (const Watch& w : watches_) {
-    if (text.find(w.needle) != std::string_view::npos) w.counter->fetch_add(1, std::memory_order_relaxed);
+    if (text.find(w.needle) != std::string_view::npos || text.find(w.local_needle) != std::string_view::npos)
+      w.counter->fetch_add(1, std::memory_order_relaxed);
   }
 }
 

@@ -50,7 +50,9 @@ class DdsLog {
   std::mutex mu_;
   int users_ = 0;
   struct Watch {
-    std::string needle;  // " <topic>/<type> ", as Cyclone's messages spell it
+    std::string needle;        // " <topic>/<type> ", as Cyclone's messages from the network spell it
+    std::string local_needle;  // " <type> failed in type conversion": delivery inside the process,
+                               // which names no topic (counted for every watched topic of the type)
     std::atomic<std::uint64_t>* counter;
   };
   std::vector<Watch> watches_;

@@ -80,3 +80,77 @@ TEST_CASE("values published on one host arrive on the other's ports; the RT part
   b.host.stop();
   a.host.stop();
 }
+
+TEST_CASE("a publisher that stops writing is late, one that is gone is lost: the port is stale until it returns") {
+  auto a = std::make_unique<BridgeHost>();
+  BridgeHost b;
+  const std::string qos = ", deadline_ms: 50, liveliness_ms: 300";
+  add_publisher(*a, "stale", qos);
+  add_subscriber(b, "stale", qos);
+  a->host.start();
+  b.host.start();
+  HandState s;
+  REQUIRE(eventually([&] { return b.read("hand_state", s).has_data() && b.stats("bridge").stale == 0; }));
+
+  // Late: the source stops (its port keeps its safe value); no sample for 50 ms misses the deadline.
+  a->host.deactivate("source");
+  REQUIRE(eventually([&] { return b.stats("bridge").topics[0].stale == 1; }));
+  CHECK(b.stats("bridge").topics[0].deadline_missed > 0);
+  const std::uint64_t seq = b.read("hand_state", s).seq;
+  std::uint64_t degraded = b.degraded("bridge");
+  REQUIRE(eventually([&] { return b.degraded("bridge") > degraded + 100; }));  // degraded every cycle
+  CHECK(b.read("hand_state", s).seq == seq);  // and no new value for the readers
+  a->host.activate("source");
+  REQUIRE(eventually([&] { return b.stats("bridge").topics[0].stale == 0 && b.read("hand_state", s).seq > seq; }));
+  CHECK(s.health == DeviceHealth::ok);
+
+  // Lost: the publishing host goes away (its writers with it).
+  a.reset();
+  REQUIRE(eventually([&] {
+    const BridgeStats st = b.stats("bridge");
+    return st.topics[0].stale == 1 && st.topics[1].stale == 1 && st.stale == 2;
+  }));
+  CHECK(b.stats("bridge").topics[1].liveliness_lost > 0);
+  const std::uint64_t lost_seq = b.read("hand_state", s).seq;
+  degraded = b.degraded("bridge");
+  REQUIRE(eventually([&] { return b.degraded("bridge") > degraded + 100; }));
+  CHECK(b.read("hand_state", s).seq == lost_seq);
+
+  // It returns.
+  a = std::make_unique<BridgeHost>();
+  add_publisher(*a, "stale", qos);
+  a->host.start();
+  REQUIRE(eventually([&] { return b.stats("bridge").stale == 0 && b.read("hand_state", s).seq > lost_seq; }));
+  CHECK(b.state("bridge") == RunState::active);
+  b.host.stop();
+  a->host.stop();
+}
+
+TEST_CASE("QoS from the configuration: a reliable subscriber refuses a best-effort publisher, not the reverse") {
+  BridgeHost a, b;
+  a.add("source", "crease_test_payload_source", 0, "{keypoints_every: 10, keypoints_count: 4}");
+  a.add("bridge", "dds_bridge", 10,
+        bridge_params("publish: [{port: hand_state, topic: " + test_topic("qos/a") +
+                      ", reliability: best_effort}, {port: keypoints, topic: " + test_topic("qos/b") +
+                      ", reliability: reliable, depth: 4}]"));
+  b.add("bridge", "dds_bridge", 0,
+        bridge_params("subscribe: [{topic: " + test_topic("qos/a") +
+                      ", port: hand_state, type: hand_state, reliability: reliable}, {topic: " + test_topic("qos/b") +
+                      ", port: keypoints, type: keypoints, reliability: best_effort}]"));
+  a.host.start();
+  b.host.start();
+  auto kp = std::make_unique<Keypoints>();
+  REQUIRE(eventually([&] { return b.read("keypoints", *kp).has_data() && kp->count == 4; }));
+  REQUIRE(eventually([&] { return b.stats("bridge").topics[0].incompatible_qos > 0; }));
+  REQUIRE(eventually([&] { return a.stats("bridge").topics[0].incompatible_qos > 0; }));
+  const BridgeStats st = b.stats("bridge");
+  CHECK(st.topics[0].samples == 0);
+  CHECK(st.topics[0].port_writes == 0);
+  CHECK(st.topics[0].stale == 1);
+  CHECK(st.topics[1].stale == 0);
+  CHECK(st.topics[1].incompatible_qos == 0);
+  HandState s;
+  CHECK_FALSE(b.read("hand_state", s).has_data());
+  b.host.stop();
+  a.host.stop();
+}

@@ -1,0 +1,105 @@
+// dds_bridge against a peer that sends bad samples (a raw Cyclone writer in this process):
+// a non-finite or out-of-range sample is dropped by the bridge's checks, a sample Cyclone cannot
+// decode (more key-points than the IDL's bound) is dropped by Cyclone; each is counted and none
+// is written into the port.
+#include <dds/dds.h>
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "HandState.h"
+#include "bridge_fixture.h"
+#include "core/port_types/hand.h"
+#include "core/port_types/keypoints.h"
+#include "rogue_keypoints.h"
+
+using namespace crease;
+using crease::test::BridgeHost;
+using crease::test::eventually;
+using crease::test::test_domain;
+using crease::test::test_topic;
+
+namespace {
+// A raw writer of `type` on `topic` with QoS the bridge's default reader accepts.
+dds_entity_t raw_writer(dds_entity_t pp, const dds_topic_descriptor_t* type, const std::string& topic) {
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(500));
+  const dds_entity_t t = dds_create_topic(pp, type, ("rt/" + topic).c_str(), q, nullptr);
+  REQUIRE(t > 0);
+  const dds_entity_t w = dds_create_writer(pp, t, q, nullptr);
+  dds_delete_qos(q);
+  REQUIRE(w > 0);
+  REQUIRE(eventually([&] {
+    dds_publication_matched_status_t m;
+    return dds_get_publication_matched_status(w, &m) == 0 && m.current_count == 1;
+  }));
+  return w;
+}
+
+struct RoguePoints {
+  std::vector<rogue_msgs_msg_dds__Keypoint_> points;
+  rogue_msgs_msg_dds__Keypoints_ sample{};
+  explicit RoguePoints(std::uint32_t n, std::uint8_t corner = 1) : points(n) {
+    for (auto& p : points) p = rogue_msgs_msg_dds__Keypoint_{{1, 2, 3}, {4, 5}, 0.5f, 7, corner, 0, 1};
+    sample.frame = n;
+    sample.points._length = sample.points._maximum = n;
+    sample.points._buffer = points.data();
+  }
+};
+}  // namespace
+
+TEST_CASE("malformed and oversized samples are dropped and counted, never written into the port") {
+  BridgeHost b;
+  b.add("bridge", "dds_bridge", 0,
+        "{domain: " + std::to_string(test_domain()) + ", subscribe: [{topic: " + test_topic("bad/hand_state") +
+            ", port: hand_state, type: hand_state}, {topic: " + test_topic("bad/keypoints") +
+            ", port: keypoints, type: keypoints}]}");
+  b.host.start();
+  const dds_entity_t pp = dds_create_participant(static_cast<dds_domainid_t>(test_domain()), nullptr, nullptr);
+  REQUIRE(pp > 0);
+
+  // hand_state: one good sample, then a NaN and an unknown health: the port keeps the good one.
+  const dds_entity_t hw = raw_writer(pp, &crease_msgs_msg_dds__HandState__desc, test_topic("bad/hand_state"));
+  crease_msgs_msg_dds__HandState_ hs{};
+  hs.commands_sent = 1;
+  REQUIRE(dds_write(hw, &hs) == 0);
+  HandState s;
+  REQUIRE(eventually([&] { return b.read("hand_state", s).has_data(); }));
+  CHECK(s.commands_sent == 1);
+  hs.commands_sent = 2;
+  hs.position_rad[3] = std::nanf("");
+  REQUIRE(dds_write(hw, &hs) == 0);
+  hs.position_rad[3] = 0;
+  hs.health = 9;
+  REQUIRE(dds_write(hw, &hs) == 0);
+  REQUIRE(eventually([&] { return b.stats("bridge").topics[0].malformed == 2; }));
+  CHECK(b.read("hand_state", s).seq == 1);
+  CHECK(s.commands_sent == 1);
+  CHECK(b.stats("bridge").topics[0].samples == 1);
+
+  // keypoints: 512 points pass, 513 are more than the IDL's bound (Cyclone refuses to decode
+  // them), a corner 7 is out of range.
+  const dds_topic_descriptor_t& r = rogue_msgs_msg_dds__Keypoints__desc;
+  const dds_topic_descriptor_t look_alike{r.m_size,  r.m_align, r.m_flagset, r.m_nkeys,
+                                          "crease_msgs::msg::dds_::Keypoints_", r.m_keys, r.m_nops, r.m_ops,
+                                          r.m_meta,  r.type_information, r.type_mapping,
+                                          r.restrict_data_representation};
+  const dds_entity_t kw = raw_writer(pp, &look_alike, test_topic("bad/keypoints"));
+  RoguePoints full(512), over(513), corner(3, 7);
+  REQUIRE(dds_write(kw, &full.sample) == 0);
+  auto kp = std::make_unique<Keypoints>();
+  REQUIRE(eventually([&] { return b.read("keypoints", *kp).has_data(); }));
+  CHECK(kp->count == 512);
+  REQUIRE(dds_write(kw, &over.sample) == 0);
+  REQUIRE(dds_write(kw, &corner.sample) == 0);
+  REQUIRE(eventually([&] {
+    const BridgeTopicStats t = b.stats("bridge").topics[1];
+    return t.undecodable == 1 && t.malformed == 1;
+  }));
+  CHECK(b.read("keypoints", *kp).seq == 1);
+  CHECK(kp->count == 512);
+  dds_delete(pp);
+  b.host.stop();
+}
