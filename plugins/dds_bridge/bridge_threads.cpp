@@ -2,19 +2,32 @@
 
 #include <pthread.h>
 
+#include <cstdio>
+
 #include "participant.h"
+#include "rt/rt_setup.h"
 
 namespace crease::dds_bridge {
 
 namespace {
-constexpr std::uint32_t kReaderStatuses = DDS_DATA_AVAILABLE_STATUS | DDS_LIVELINESS_CHANGED_STATUS |
-                                          DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_SAMPLE_LOST_STATUS |
-                                          DDS_SAMPLE_REJECTED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
-                                          DDS_SUBSCRIPTION_MATCHED_STATUS;
+// On the thread itself: SCHED_FIFO at `priority` when it is > 0 (a refusal is reported, not fatal).
+void set_priority(const char* name, int priority) {
+  if (priority <= 0) return;
+  crease::rt::ThreadSettings s;
+  s.priority = priority;
+  s.stack_prefault_bytes = 0;
+  for (const auto& step : crease::rt::apply_thread_settings(name, s))
+    if (!step.applied) std::fprintf(stderr, "dds_bridge: %s not applied: %s\n", step.what.c_str(), step.why.c_str());
+}
+// Sets the listener for status S: the link's counters take it (on_status).
+template <class S, class Setter>
+void set_status(dds_listener_t* l, Setter setter) {
+  setter(l, [](dds_entity_t, const S status, void* arg) { on_status(static_cast<SubscribeLink*>(arg)->counters(), status); });
+}
 }  // namespace
 
-PublisherThread::PublisherThread(std::vector<PublishLink*> links) : links_(std::move(links)) {
-  thread_ = std::thread([this] { run(); });
+PublisherThread::PublisherThread(std::vector<PublishLink*> links, int priority) : links_(std::move(links)) {
+  thread_ = std::thread([this, priority] { run(priority); });
   pthread_setname_np(thread_.native_handle(), "dds-publish");
 }
 
@@ -25,7 +38,8 @@ PublisherThread::~PublisherThread() {
   thread_.join();
 }
 
-void PublisherThread::run() {
+void PublisherThread::run(int priority) {
+  set_priority("dds-publish", priority);
   for (;;) {
     // Read the counter before the channels: a wake during the pass makes wait() return at once.
     const std::uint32_t seen = wake_.load(std::memory_order_acquire);
@@ -35,41 +49,27 @@ void PublisherThread::run() {
   }
 }
 
-SubscriberThread::SubscriberThread(dds_entity_t participant, std::vector<SubscribeLink*> links)
-    : links_(std::move(links)) {
-  waitset_ = dds_create_waitset(participant);
-  stop_guard_ = dds_create_guardcondition(participant);
-  if (waitset_ < 0 || stop_guard_ < 0 || dds_waitset_attach(waitset_, stop_guard_, 0) < 0)
-    throw ParamError("subscribe", "no DDS waitset for the subscriber thread");
-  for (std::size_t i = 0; i < links_.size(); ++i) {
-    const dds_entity_t r = links_[i]->reader();
-    if (dds_set_status_mask(r, kReaderStatuses) < 0 ||
-        dds_waitset_attach(waitset_, r, static_cast<dds_attach_t>(i + 1)) < 0)
-      throw ParamError("subscribe", "cannot wait on the reader of " + links_[i]->topic());
+SubscriberListeners::SubscriberListeners(std::vector<SubscribeLink*> links) : links_(std::move(links)) {
+  for (SubscribeLink* link : links_) {
+    dds_listener_t* l = dds_create_listener(link);
+    const auto on_data = [](dds_entity_t, void* arg) { static_cast<SubscribeLink*>(arg)->receive(); };
+    dds_lset_data_available(l, on_data);
+    set_status<dds_liveliness_changed_status_t>(l, &dds_lset_liveliness_changed);
+    set_status<dds_requested_deadline_missed_status_t>(l, &dds_lset_requested_deadline_missed);
+    set_status<dds_sample_lost_status_t>(l, &dds_lset_sample_lost);
+    set_status<dds_sample_rejected_status_t>(l, &dds_lset_sample_rejected);
+    set_status<dds_requested_incompatible_qos_status_t>(l, &dds_lset_requested_incompatible_qos);
+    set_status<dds_subscription_matched_status_t>(l, &dds_lset_subscription_matched);
+    const dds_return_t rc = dds_set_listener(link->reader(), l);
+    dds_delete_listener(l);
+    if (rc < 0) throw ParamError("subscribe", "cannot listen to the reader of " + link->topic());
+    catch_up_statuses(link->reader(), link->counters());  // what came before the listener was set
+    link->receive();
   }
-  thread_ = std::thread([this] { run(); });
-  pthread_setname_np(thread_.native_handle(), "dds-subscribe");
 }
 
-SubscriberThread::~SubscriberThread() {
-  stop_.store(true, std::memory_order_release);
-  dds_set_guardcondition(stop_guard_, true);
-  thread_.join();
-  dds_delete(waitset_);
-  dds_delete(stop_guard_);
-}
-
-void SubscriberThread::run() {
-  std::vector<dds_attach_t> triggered(links_.size() + 1);
-  // Samples may have come before the waitset was attached: look once.
-  for (SubscribeLink* l : links_) l->receive();
-  while (!stop_.load(std::memory_order_acquire)) {
-    const dds_return_t n = dds_waitset_wait(waitset_, triggered.data(), triggered.size(), DDS_INFINITY);
-    for (dds_return_t i = 0; i < n; ++i) {
-      const dds_attach_t a = triggered[static_cast<std::size_t>(i)];
-      if (a >= 1 && static_cast<std::size_t>(a) <= links_.size()) links_[static_cast<std::size_t>(a) - 1]->receive();
-    }
-  }
+SubscriberListeners::~SubscriberListeners() {
+  for (SubscribeLink* link : links_) dds_set_listener(link->reader(), nullptr);
 }
 
 }  // namespace crease::dds_bridge

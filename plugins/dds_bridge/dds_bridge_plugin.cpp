@@ -4,6 +4,8 @@
 //   dds_config: FILE   CycloneDDS XML: domain, interfaces, peers (relative to the configuration
 //                      file; default dds/loopback.xml beside it: loopback only, no multicast)
 //   domain: N          domain id (default: the XML's <Domain Id>, 0 when it says "any")
+//   thread_priority: N SCHED_FIFO priority of the bridge's publisher thread, below the loops'
+//                      (default 0: SCHED_OTHER; Cyclone's own threads take theirs from the XML)
 //   publish:   [{port: P, topic: T, type: K, <QoS>}]   each new value of port P -> DDS topic rt/T
 //   subscribe: [{topic: T, port: P, type: K, <QoS>}]   samples of rt/T -> port P (this bridge writes it)
 //   type: keypoints | hand_state | hand_command   (optional when port P is already bound: its type)
@@ -12,7 +14,7 @@
 // Status: degraded while a subscribed topic is stale (never heard, its publisher lost or late).
 // RT: update copies subscribed samples from the links' channels into their ports; the write
 // phase copies new values of published ports into the links' channels and wakes the publisher
-// thread. Every DDS call runs on the bridge's threads (bridge_threads.h).
+// thread. Every DDS call runs on the bridge's thread or Cyclone's (bridge_threads.h), never a loop's.
 #include <filesystem>
 #include <memory>
 #include <set>
@@ -62,6 +64,7 @@ class DdsBridge final : public crease::Plugin {
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     const std::string xml = path_param(p, p.get<std::string>("dds_config", "dds/loopback.xml"));
     const int domain = p.get_in_range<int>("domain", -1, 0, Participant::kMaxDomainId);
+    const int priority = p.get_in_range<int>("thread_priority", 0, 0, 98);
     try {
       participant_ = std::make_unique<Participant>(xml, p.has("domain") ? domain : -1);
     } catch (const ParamError& e) {
@@ -91,10 +94,10 @@ class DdsBridge final : public crease::Plugin {
     for (auto& l : publish_) pl.push_back(l.get());
     std::vector<SubscribeLink*> sl;
     for (auto& l : subscribe_) sl.push_back(l.get());
-    if (!pl.empty()) publisher_ = std::make_unique<PublisherThread>(std::move(pl));
+    if (!pl.empty()) publisher_ = std::make_unique<PublisherThread>(std::move(pl), priority);
     if (!sl.empty()) {
       try {
-        subscriber_ = std::make_unique<SubscriberThread>(participant_->handle(), std::move(sl));
+        subscriber_ = std::make_unique<SubscriberListeners>(std::move(sl));
       } catch (const ParamError& e) {
         p.fail(e.key(), e.what());
       }
@@ -129,7 +132,7 @@ class DdsBridge final : public crease::Plugin {
   }
 
   void cleanup() override {
-    // Threads first (they use the links), then the links' endpoints, then the participant.
+    // Listeners and thread first (they use the links), then the links' endpoints, then the participant.
     subscriber_.reset();
     publisher_.reset();
     subscribe_.clear();
@@ -164,7 +167,7 @@ class DdsBridge final : public crease::Plugin {
   std::vector<std::unique_ptr<PublishLink>> publish_;
   std::vector<std::unique_ptr<SubscribeLink>> subscribe_;
   std::unique_ptr<PublisherThread> publisher_;
-  std::unique_ptr<SubscriberThread> subscriber_;
+  std::unique_ptr<SubscriberListeners> subscriber_;
   crease::LatestOutput<crease::BridgeStats> stats_out_;
   std::unique_ptr<crease::BridgeStats> stats_;
   std::int64_t stats_ns_ = INT64_MIN / 2;

@@ -48,45 +48,42 @@ void Link::stats_rt(BridgeTopicStats& out) const noexcept {
   out.incompatible_qos = get(c.incompatible_qos);
 }
 
-void take_reader_statuses(dds_entity_t reader, LinkCounters& c) {
-  std::uint32_t st = 0;
-  if (dds_take_status(reader, &st, DDS_LIVELINESS_CHANGED_STATUS | DDS_REQUESTED_DEADLINE_MISSED_STATUS |
-                                       DDS_SAMPLE_LOST_STATUS | DDS_SAMPLE_REJECTED_STATUS |
-                                       DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS | DDS_SUBSCRIPTION_MATCHED_STATUS) < 0)
-    return;
-  const auto add = [](std::atomic<std::uint64_t>& a, std::int64_t n) {
-    if (n > 0) a.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
-  };
-  if (st & DDS_LIVELINESS_CHANGED_STATUS) {
-    dds_liveliness_changed_status_t s;
-    if (dds_get_liveliness_changed_status(reader, &s) == 0) {
-      add(c.liveliness_lost, -static_cast<std::int64_t>(s.alive_count_change));
-      if (s.alive_count == 0) c.stale.store(true, std::memory_order_release);
-    }
-  }
-  if (st & DDS_REQUESTED_DEADLINE_MISSED_STATUS) {
-    dds_requested_deadline_missed_status_t s;
-    if (dds_get_requested_deadline_missed_status(reader, &s) == 0) {
-      add(c.deadline_missed, s.total_count_change);
-      c.stale.store(true, std::memory_order_release);
-    }
-  }
-  if (st & DDS_SAMPLE_LOST_STATUS) {
-    dds_sample_lost_status_t s;
-    if (dds_get_sample_lost_status(reader, &s) == 0) add(c.lost, s.total_count_change);
-  }
-  if (st & DDS_SAMPLE_REJECTED_STATUS) {
-    dds_sample_rejected_status_t s;
-    if (dds_get_sample_rejected_status(reader, &s) == 0) add(c.rejected, s.total_count_change);
-  }
-  if (st & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) {
-    dds_requested_incompatible_qos_status_t s;
-    if (dds_get_requested_incompatible_qos_status(reader, &s) == 0) add(c.incompatible_qos, s.total_count_change);
-  }
-  if (st & DDS_SUBSCRIPTION_MATCHED_STATUS) {
-    dds_subscription_matched_status_t s;
-    if (dds_get_subscription_matched_status(reader, &s) == 0) c.matched.store(s.current_count, std::memory_order_relaxed);
-  }
+namespace {
+void add(std::atomic<std::uint64_t>& a, std::int64_t n) {
+  if (n > 0) a.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
+}
+}  // namespace
+
+void on_status(LinkCounters& c, const dds_liveliness_changed_status_t& s) {
+  add(c.liveliness_lost, -static_cast<std::int64_t>(s.alive_count_change));
+  if (s.alive_count == 0) c.stale.store(true, std::memory_order_release);
+}
+void on_status(LinkCounters& c, const dds_requested_deadline_missed_status_t& s) {
+  add(c.deadline_missed, s.total_count_change);
+  c.stale.store(true, std::memory_order_release);
+}
+void on_status(LinkCounters& c, const dds_sample_lost_status_t& s) { add(c.lost, s.total_count_change); }
+void on_status(LinkCounters& c, const dds_sample_rejected_status_t& s) { add(c.rejected, s.total_count_change); }
+void on_status(LinkCounters& c, const dds_requested_incompatible_qos_status_t& s) {
+  add(c.incompatible_qos, s.total_count_change);
+}
+void on_status(LinkCounters& c, const dds_subscription_matched_status_t& s) {
+  c.matched.store(s.current_count, std::memory_order_relaxed);
+}
+
+void catch_up_statuses(dds_entity_t reader, LinkCounters& c) {
+  dds_liveliness_changed_status_t l;
+  if (dds_get_liveliness_changed_status(reader, &l) == 0) on_status(c, l);
+  dds_requested_deadline_missed_status_t d;
+  if (dds_get_requested_deadline_missed_status(reader, &d) == 0 && d.total_count_change > 0) on_status(c, d);
+  dds_sample_lost_status_t lost;
+  if (dds_get_sample_lost_status(reader, &lost) == 0) on_status(c, lost);
+  dds_sample_rejected_status_t r;
+  if (dds_get_sample_rejected_status(reader, &r) == 0) on_status(c, r);
+  dds_requested_incompatible_qos_status_t q;
+  if (dds_get_requested_incompatible_qos_status(reader, &q) == 0) on_status(c, q);
+  dds_subscription_matched_status_t m;
+  if (dds_get_subscription_matched_status(reader, &m) == 0) on_status(c, m);
 }
 
 void take_writer_statuses(dds_entity_t writer, LinkCounters& c) {

@@ -3,7 +3,7 @@
 //
 // Each link owns a lock-free rt::LatestChannel between the RT side and its non-RT side:
 //   publish:   RT write phase: port -> channel (take_rt); publisher thread: channel -> dds_write
-//   subscribe: subscriber thread: dds_take -> checks -> channel (receive); RT update: channel -> port
+//   subscribe: reader listener: dds_take -> checks -> channel (receive); RT update: channel -> port
 // Counters are atomics the non-RT side adds to and the RT side reads (stats_rt), never locks.
 #pragma once
 
@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "core/port.h"
@@ -82,16 +83,24 @@ class PublishLink : public Link {
 class SubscribeLink : public Link {
  public:
   SubscribeLink(std::string topic) : Link(std::move(topic), BridgeTopicStats::subscribe) {}
-  // Subscriber thread, when the reader's waitset entry triggered: statuses, then samples.
+  // The reader's data listener (a Cyclone thread): takes the samples. One call at a time (a
+  // lock: several Cyclone threads may call). The status listeners call on_status (links.cpp).
   virtual void receive() = 0;
   [[nodiscard]] virtual dds_entity_t reader() const noexcept = 0;
   // RT (update): the newest sample into the port unless stale; true when the port is fresh.
   virtual bool give_rt() noexcept = 0;
 };
 
-// Subscriber thread: takes and clears the reader's statuses into `c` (liveliness, deadline,
-// lost, rejected, incompatible QoS, matched).
-void take_reader_statuses(dds_entity_t reader, LinkCounters& c);
+// A reader's status listeners (Cyclone threads): Cyclone hands each its status (and resets it).
+// Liveliness with no writer alive, or a missed deadline, makes the link stale.
+void on_status(LinkCounters& c, const dds_liveliness_changed_status_t& s);
+void on_status(LinkCounters& c, const dds_requested_deadline_missed_status_t& s);
+void on_status(LinkCounters& c, const dds_sample_lost_status_t& s);
+void on_status(LinkCounters& c, const dds_sample_rejected_status_t& s);
+void on_status(LinkCounters& c, const dds_requested_incompatible_qos_status_t& s);
+void on_status(LinkCounters& c, const dds_subscription_matched_status_t& s);
+// The same for every status of `reader` that changed before its listener was set.
+void catch_up_statuses(dds_entity_t reader, LinkCounters& c);
 // Publisher thread: the writer's matched and incompatible-QoS statuses into `c`.
 void take_writer_statuses(dds_entity_t writer, LinkCounters& c);
 
@@ -161,7 +170,7 @@ class SubscribeLinkT final : public SubscribeLink {
   [[nodiscard]] dds_entity_t reader() const noexcept override { return endpoint_.handle(); }
 
   void receive() override {
-    take_reader_statuses(endpoint_.handle(), counters());
+    const std::lock_guard lock(receiving_);
     constexpr int kBatch = 8;
     void* samples[kBatch] = {};
     dds_sample_info_t infos[kBatch];
@@ -206,11 +215,12 @@ class SubscribeLinkT final : public SubscribeLink {
 
  private:
   LatestOutput<T> out_;         // RT side
-  rt::LatestChannel channel_;   // subscriber thread -> RT
+  rt::LatestChannel channel_;   // listener -> RT
   rt::LatestReader<T> reader_;  // RT side
   std::uint64_t written_seq_ = 0;
   Endpoint endpoint_;
-  std::unique_ptr<T> staging_;  // subscriber thread: the sample being checked
+  std::mutex receiving_;        // listener calls: one at a time (never taken by the RT side)
+  std::unique_ptr<T> staging_;  // listener: the sample being checked
 };
 
 }  // namespace crease::dds_bridge
