@@ -2,6 +2,9 @@
 // it was (no peer needed).
 #include <doctest/doctest.h>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -93,4 +96,36 @@ TEST_CASE("the CycloneDDS XML: unreadable, refused by Cyclone, another domain, o
                                                   "</AllowMulticast></General></Domain></CycloneDDS>");
   CHECK(names(error_of(h, d() + "dds_config: " + other + ", " + link), "dds_config", "already runs in this process with"));
   for (const auto& f : {bad, none, three, other}) std::filesystem::remove(f);
+}
+
+TEST_CASE("thread_priority: the publisher thread runs SCHED_FIFO at it (where permitted); out of range is refused") {
+  BridgeHost h;
+  h.add("source", "crease_test_payload_source", 0, "{}");
+  CHECK(names(error_of(h, d() + "thread_priority: 99, publish: [{port: hand_state, topic: a}]}"), "thread_priority",
+              "must be in [0, 98], got 99"));
+  sched_param probe{};
+  probe.sched_priority = 1;
+  pthread_t self = pthread_self();
+  int policy = 0;
+  sched_param was{};
+  pthread_getschedparam(self, &policy, &was);
+  if (pthread_setschedparam(self, SCHED_FIFO, &probe) != 0) {
+    MESSAGE("SCHED_FIFO not permitted here: the priority itself is not checked");
+    return;
+  }
+  pthread_setschedparam(self, policy, &was);
+  h.add("bridge", "dds_bridge", 10, d() + "thread_priority: 7, publish: [{port: hand_state, topic: a}]}");
+  bool found = false;
+  REQUIRE(crease::test::eventually([&] {
+    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+      std::ifstream comm(task.path() / "comm");
+      std::string name;
+      std::getline(comm, name);
+      if (name != "dds-publish") continue;
+      sched_param sp{};
+      const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+      found = sched_getscheduler(tid) == SCHED_FIFO && sched_getparam(tid, &sp) == 0 && sp.sched_priority == 7;
+    }
+    return found;
+  }));
 }
