@@ -10,12 +10,13 @@
 //   wire: from the peer's port write to the sample in this bridge's channel, ready for its
 //         next update (the port stamp a subscribed bridge writes is that arrival time);
 //   port: to the probe's update that read it (wire + the wait for this loop's next cycle).
-// Beside it, Cyclone's ddsperf ping-pong with the same sample sizes and rates, in the same run
-// and with the same XML; its one-way figure is the round trip / 2. ddsperf prints percentiles
-// per second: its figures (and ours in the comparison) are the median over seconds, max the max.
-// Finally the wake-up latency p99 of this process's 1 kHz loop with the bridge (peer bridging)
-// against without (the same peer and loop, no bridge on either side), in alternating turns.
-// Takes about 2N + 1.5N seconds.
+// Beside it, Cyclone's ddsperf ping-pong with the same sample sizes and rates, in the same run,
+// with the same XML and beside the same two 1 kHz loops (no bridge); its one-way figure is the
+// round trip / 2. ddsperf prints percentiles per second: its figures (and ours in the
+// comparison) are the median over seconds, max the max. And the wake-up latency p99 of this
+// process's 1 kHz loop with the bridge (peer bridging) against without (the same peer and loop,
+// no bridge on either side, no ddsperf). The three kinds of turn alternate; N seconds each, about
+// 3N + 10 s in all.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -182,14 +183,65 @@ void accumulate(crease::rt::HistogramSnapshot& into, const crease::rt::Histogram
   into.max_ns = std::max(into.max_ns, s.max_ns);
 }
 
+// Cyclone's ddsperf ping-pong: `size` bytes at `rate_hz` for `seconds` on its own domain, started
+// by start() and read by finish(), which adds its per-second lines (round trip / 2: one way).
+class DdsPerf {
+ public:
+  DdsPerf(int size, int rate_hz, int domain, const std::string& xml) : size_(size), rate_(rate_hz), domain_(domain), xml_(xml) {}
+  bool start(double seconds) {
+    const std::string env = "CYCLONEDDS_URI=file://" + xml_ + " ddsperf -i " + std::to_string(domain_) + " -D ";
+    const long dur = std::lround(seconds) + 1;
+    if (std::system((env + std::to_string(dur + 2) + " pong >/dev/null 2>&1 &").c_str()) != 0) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ping_ = popen((env + std::to_string(dur) + " ping " + std::to_string(rate_) + "Hz size " + std::to_string(size_) +
+                   " 2>&1").c_str(), "r");
+    return ping_ != nullptr;
+  }
+  void finish() {
+    if (ping_ == nullptr) return;
+    static const std::regex line(
+        R"(size (\d+) mean [\d.]+us min [\d.]+us 50% ([\d.]+)us 90% [\d.]+us 99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
+    char buf[1024];
+    bool first = true;
+    while (std::fgets(buf, sizeof(buf), ping_) != nullptr) {
+      std::cmatch m;
+      if (!std::regex_search(buf, m, line)) continue;
+      if (first) {  // its first second includes discovery
+        first = false;
+        continue;
+      }
+      p50s_.push_back(std::stod(m[2].str()) / 2);
+      p99s_.push_back(std::stod(m[3].str()) / 2);
+      max_ = std::max(max_, std::stod(m[4].str()) / 2);
+      n_ += std::stoul(m[5].str());
+    }
+    pclose(ping_);
+    ping_ = nullptr;
+  }
+  [[nodiscard]] bool ran() const noexcept { return !p99s_.empty(); }
+  // Median over its seconds; max the largest.
+  [[nodiscard]] Dist one_way() const { return Dist{median(p50s_), median(p99s_), max_, n_}; }
+
+ private:
+  int size_, rate_, domain_;
+  std::string xml_;
+  FILE* ping_ = nullptr;
+  std::vector<double> p50s_, p99s_;
+  double max_ = 0;
+  std::size_t n_ = 0;
+};
+
 struct Collected {
   std::vector<std::pair<std::int64_t, double>> wire[2], port[2];  // [kind]: (arrival, us)
 };
 
 // One turn: the peer (bridging or not) and this process's loop (with the bridge, probe and echo,
 // or a no-op), `seconds` measured after a warm-up. Adds the loop's wake-up latency into `wake`.
+// Without the bridge, the `perf` ping-pongs (when given) run during the turn instead: ddsperf
+// meets the same two 1 kHz loops the bridge does.
 void turn(bool bridge, double seconds, int priority, int cpu, int domain, const std::string& xml,
-          const std::string& creased, const fs::path& dir, crease::rt::HistogramSnapshot& wake, Collected& got) {
+          const std::string& creased, const fs::path& dir, crease::rt::HistogramSnapshot& wake, Collected& got,
+          std::vector<DdsPerf*> perf = {}) {
   Peer peer(dir / (bridge ? "with" : "without"), peer_yaml(bridge, domain, xml), creased);
   crease::PluginHost host({CREASE_PLUGIN_DIR});
   host.add_loop({"control", 1000.0, priority, cpu});
@@ -223,6 +275,7 @@ void turn(bool bridge, double seconds, int priority, int cpu, int domain, const 
     drain(false);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  for (DdsPerf* p : perf) p->start(seconds);
   const crease::rt::HistogramSnapshot before = host.loops()[0]->timing().wakeup_latency.snapshot();
   const auto end = Clock::now() + std::chrono::duration<double>(seconds);
   while (Clock::now() < end) {
@@ -231,54 +284,8 @@ void turn(bool bridge, double seconds, int priority, int cpu, int domain, const 
   }
   accumulate(wake, minus(host.loops()[0]->timing().wakeup_latency.snapshot(), before));
   drain(true);
+  for (DdsPerf* p : perf) p->finish();
   host.stop();
-}
-
-// ddsperf ping-pong: `size` bytes at `rate_hz` for `seconds`. One-way figures (round trip / 2),
-// median over its per-second lines; false with `why` when it does not run.
-bool ddsperf(int size, int rate_hz, double seconds, int domain, const std::string& xml, Dist& out, std::string& why) {
-  const std::string env = "CYCLONEDDS_URI=file://" + xml + " ";
-  const std::string d = " -i " + std::to_string(domain) + " ";
-  const long dur = std::lround(seconds);
-  const std::string pong = env + "ddsperf" + d + "-D " + std::to_string(dur + 3) + " pong >/dev/null 2>&1 &";
-  if (std::system(pong.c_str()) != 0) {
-    why = "cannot start ddsperf pong";
-    return false;
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  const std::string ping = env + "ddsperf" + d + "-D " + std::to_string(dur + 1) + " ping " +
-                           std::to_string(rate_hz) + "Hz size " + std::to_string(size) + " 2>&1";
-  FILE* f = popen(ping.c_str(), "r");
-  if (f == nullptr) {
-    why = "cannot run ddsperf";
-    return false;
-  }
-  static const std::regex line(R"(size (\d+) mean [\d.]+us min [\d.]+us 50% ([\d.]+)us 90% [\d.]+us 99% ([\d.]+)us max ([\d.]+)us cnt (\d+))");
-  std::vector<double> p50s, p99s;
-  double max = 0;
-  std::size_t n = 0;
-  char buf[1024];
-  bool first = true;
-  while (std::fgets(buf, sizeof(buf), f) != nullptr) {
-    std::cmatch m;
-    if (!std::regex_search(buf, m, line)) continue;
-    if (first) {  // its first second includes discovery
-      first = false;
-      continue;
-    }
-    p50s.push_back(std::stod(m[2].str()) / 2);
-    p99s.push_back(std::stod(m[3].str()) / 2);
-    max = std::max(max, std::stod(m[4].str()) / 2);
-    n += std::stoul(m[5].str());
-  }
-  pclose(f);
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // pong ends on its own
-  if (p99s.empty()) {
-    why = "ddsperf printed no round trips (pong not discovered?)";
-    return false;
-  }
-  out = Dist{median(p50s), median(p99s), max, n};
-  return true;
 }
 
 void print_row(const char* name, const Dist& d) {
@@ -295,15 +302,19 @@ int run(int argc, char** argv) {
   const std::string xml = std::string(CREASE_SOURCE_DIR) + "/config/dds/loopback.xml";
   const std::string creased = (fs::read_symlink("/proc/self/exe").parent_path() / "creased").string();
   const fs::path dir = fs::temp_directory_path() / ("crease-bench-dds-" + std::to_string(::getpid()));
-  std::printf("dds: two processes over loopback (%s), domain %d; %d turns of %.1f s with and without the bridge; "
-              "this loop 1 kHz at priority %d, the bridges' threads at %d\n",
+  std::printf("dds: two processes over loopback (%s), domain %d; %d turns of %.1f s each without the bridge, "
+              "with it, and with ddsperf instead; this loop 1 kHz at priority %d, the bridges' threads at %d\n",
               xml.c_str(), domain, turns, seconds / turns, priority, g_thread_priority);
 
-  crease::rt::HistogramSnapshot with, without;
+  crease::rt::HistogramSnapshot with, without, beside_perf;
   Collected got;
+  // ddsperf on two domains of its own (one per sample size), beside the same loops.
+  DdsPerf perf_hand(kHandStateBytes, 1000, 201 + (domain - 201 + 10) % 30, xml);
+  DdsPerf perf_kp(kKeypointsBytes, 15, 201 + (domain - 201 + 20) % 30, xml);
   for (int t = 0; t < turns; ++t) {
     turn(false, seconds / turns, priority, cpu, domain, xml, creased, dir, without, got);
     turn(true, seconds / turns, priority, cpu, domain, xml, creased, dir, with, got);
+    turn(false, seconds / turns, priority, cpu, domain, xml, creased, dir, beside_perf, got, {&perf_hand, &perf_kp});
   }
   fs::remove_all(dir);
 
@@ -321,16 +332,13 @@ int run(int argc, char** argv) {
     for (const auto& [t, us] : got.port[k]) v.push_back(us);
     print_row("  to the reading plugin (next 1 kHz cycle)", dist_of(v));
   }
-  Dist perf[2];
-  bool have_perf = true;
-  std::string why;
-  have_perf = ddsperf(kHandStateBytes, 1000, seconds / 2, domain, xml, perf[0], why) &&
-              ddsperf(kKeypointsBytes, 15, seconds, domain, xml, perf[1], why);
+  const bool have_perf = perf_hand.ran() && perf_kp.ran();
+  const Dist perf[2] = {perf_hand.one_way(), perf_kp.one_way()};
   if (have_perf) {
     print_row("ddsperf ping-pong 144 B, 1 kHz: round trip / 2", perf[0]);
     print_row("ddsperf ping-pong 16408 B, 15 Hz: round trip / 2", perf[1]);
   } else {
-    std::printf("  ddsperf: not available: %s\n", why.c_str());
+    std::printf("  ddsperf: printed no round trips (not installed, or its pong not discovered)\n");
   }
   const double w99 = double(with.percentile(99)) / 1e3, wo99 = double(without.percentile(99)) / 1e3;
   std::printf("\n  1 kHz loop wake-up (us)   p50 %7.1f  p99 %7.1f  max %8.1f  with the bridge (%llu cycles)\n",
