@@ -271,16 +271,6 @@ void read_safety(const MapReader& root, DaemonConfig& cfg) {
 
 }  // namespace
 
-std::string SourceLoc::str() const {
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
-}
-
-ConfigError::ConfigError(SourceLoc loc, std::string key_path, std::string reason)
-    : std::runtime_error(loc.str() + ": " + key_path + ": " + reason),
-      loc_(std::move(loc)),
-      key_path_(std::move(key_path)),
-      reason_(std::move(reason)) {}
-
 ConfigError error_at(const std::string& file, const YAML::Node& node, const std::string& key_path,
                      const std::string& reason) {
   return ConfigError(loc_of(file, node), key_path, reason);

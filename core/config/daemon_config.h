@@ -12,38 +12,19 @@
 #include <cstdint>
 #include <map>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/errors.h"
+
 namespace crease::config {
 
-// Where an item came from, so later errors (plugin load, parameter validation) can point
-// back to it. line/column are 1-based; 0 when unknown.
-struct SourceLoc {
-  std::string file;
-  int line = 0;
-  int column = 0;
-
-  // "FILE:LINE:COLUMN"
-  [[nodiscard]] std::string str() const;
-};
-
-class ConfigError : public std::runtime_error {
- public:
-  ConfigError(SourceLoc loc, std::string key_path, std::string reason);
-
-  [[nodiscard]] const SourceLoc& loc() const noexcept { return loc_; }
-  [[nodiscard]] const std::string& key_path() const noexcept { return key_path_; }
-  [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
-
- private:
-  SourceLoc loc_;
-  std::string key_path_;
-  std::string reason_;
-};
+// Where an item came from (so later errors, plugin load and parameter validation, can point
+// back to it), and the error every failure throws: crease's own (core/errors.h).
+using crease::ConfigError;
+using crease::SourceLoc;
 
 // "FILE:LINE:COLUMN: KEY.PATH: reason" for a YAML node of a loaded config; a plugin that
 // rejects one of its params uses this so its message points into the config file.

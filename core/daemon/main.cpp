@@ -54,10 +54,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<crease::daemon::Daemon> daemon;
   try {
     daemon = std::make_unique<crease::daemon::Daemon>(crease::config::load_daemon_config(config_file), options);
-  } catch (const crease::config::ConfigError& e) {
-    std::fprintf(stderr, "creased: %s\n", e.what());
-    return 2;
-  } catch (const crease::Error& e) {
+  } catch (const crease::Error& e) {  // ConfigError, LoadError, PortError
     std::fprintf(stderr, "creased: %s\n", e.what());
     return 2;
   }

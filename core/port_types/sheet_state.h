@@ -48,18 +48,19 @@ struct SheetState {
   }
 };
 
-struct TargetPoint {
-  float world_mm[3];
-  float sheet_mm[2];
-};
-
 struct TargetPoints {
   static constexpr char kPortType[] = "crease.TargetPoints";
   static constexpr std::uint32_t kPortVersion = 1;
   static constexpr std::uint32_t kCapacity = 1024;
+  // One target as it travels on the port (floats, mm); the model's own form, in doubles, is
+  // sheet::TargetPoint (plugins/sheet_model/sheet_model.h).
+  struct Point {
+    float world_mm[3];  // world frame
+    float sheet_mm[2];  // (u, v) on the sheet
+  };
   std::int64_t timestamp_ns = 0;
   std::uint32_t count = 0;
-  TargetPoint points[kCapacity];
+  Point points[kCapacity];
   // Non-finite entries are tolerated here: the model drops them one by one.
 };
 

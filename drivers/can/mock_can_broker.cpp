@@ -24,7 +24,7 @@
 namespace crease::drivers {
 namespace {
 
-using mockwire::now_ns;
+using rt::now_ns;
 using mockwire::Record;
 
 [[noreturn]] void fail(const std::string& bus, const char* what) {

@@ -33,12 +33,6 @@ void cpu_relax() noexcept {
 
 }  // namespace
 
-std::int64_t now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
-
 std::shared_ptr<Reactor> Reactor::instance() {
   static std::mutex mu;
   static std::weak_ptr<Reactor> current;
@@ -164,7 +158,7 @@ void Reactor::run() {
       lk.lock();
       continue;
     }
-    const std::int64_t now = now_ns();
+    const std::int64_t now = rt::now_ns();
     std::int64_t first_sent = -1;  // earliest send time of what moved (not when we noticed)
     for (BrokerCore* c : cores_) {
       const std::int64_t t = c->tick(now);
@@ -174,18 +168,18 @@ void Reactor::run() {
       // A burst starts after a sleep (the devices' answers to a cycle's frames, within
       // kMinPeriodNs, belong to that cycle's burst).
       if (!in_burst && bursts_.on_activity(first_sent)) in_burst = true;
-      spin_until = now_ns() + kSpinNs;
+      spin_until = rt::now_ns() + kSpinNs;
     }
     if (any_pending()) continue;
     // Poll the rings a little longer: the answers to what just moved are usually close, and
     // so is a predicted burst.
     const std::int64_t predicted = in_burst ? -1 : bursts_.next_ns();
-    const std::int64_t t_spin = now_ns();
+    const std::int64_t t_spin = rt::now_ns();
     if (predicted > 0 && t_spin >= predicted - kLeadNs && t_spin < predicted + kWindowNs) {
       spin_until = std::max(spin_until, predicted + kWindowNs);
     }
     bool again = false;
-    while (now_ns() < spin_until && waiters_.load(std::memory_order_relaxed) == 0 &&
+    while (rt::now_ns() < spin_until && waiters_.load(std::memory_order_relaxed) == 0 &&
            !stop_.load(std::memory_order_relaxed)) {
       if (any_pending()) {
         again = true;
@@ -207,7 +201,7 @@ void Reactor::run() {
       const std::int64_t d = c->next_deadline_ns();
       if (d >= 0) next = next < 0 ? d : std::min(next, d);
     }
-    const std::int64_t before = now_ns();
+    const std::int64_t before = rt::now_ns();
     const std::int64_t next_burst = bursts_.next_ns();
     follow_schedule(next_burst > before);
     if (next_burst > 0 && next_burst - kLeadNs > before) {
@@ -223,7 +217,7 @@ void Reactor::run() {
     const int n = ::epoll_pwait2(epoll_fd_, events, 64, next >= 0 ? &timeout : nullptr, nullptr);
     lk.lock();
     page_->sleeping.store(0, std::memory_order_relaxed);
-    const std::int64_t t = now_ns();
+    const std::int64_t t = rt::now_ns();
     for (int i = 0; i < n; ++i) {
       const int fd = events[i].data.fd;
       if (fd == doorbell_fd_) {

@@ -19,10 +19,9 @@
 #include <vector>
 
 #include "drivers/can/mock_wire.h"
+#include "rt/clock.h"
 
 namespace crease::drivers::mockwire {
-
-std::int64_t now_ns() noexcept;
 
 // Predicts when the next burst of traffic starts, when bursts come on a steady schedule (a
 // control loop's period). Phase-locked: a start within 5 % of the period of the expected

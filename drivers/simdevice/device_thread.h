@@ -12,7 +12,7 @@
 #include <functional>
 #include <thread>
 
-#include "drivers/simdevice/sim_clock.h"
+#include "rt/clock.h"
 
 namespace crease::drivers::sim {
 
@@ -28,7 +28,7 @@ class DeviceThread {
           while (!stop_.load(std::memory_order_acquire)) {
             pollfd p{fd, POLLIN, 0};
             (void)::poll(&p, 1, period_ms);
-            step(now_ns());
+            step(rt::now_ns());
           }
         }) {}
   ~DeviceThread() {

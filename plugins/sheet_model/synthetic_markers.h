@@ -9,14 +9,17 @@
 
 namespace crease::sheet {
 
-struct MarkerLayout {
+// A regular grid of square markers, centred in equal cells of the sheet: only what the
+// key-points' sheet positions need. The printed layout the cameras detect (ids, faces, the
+// dictionary, a layout file) is vision::MarkerLayout (plugins/vision/marker_layout.h).
+struct SyntheticMarkerGrid {
   int cols = 5, rows = 7;
   double width_mm = 210, height_mm = 297;
   double marker_mm = 20;
 };
 
 // Key-point sheet positions, marker by marker: centre, then the four corners.
-[[nodiscard]] inline std::vector<Vec2> marker_keypoints(const MarkerLayout& m) {
+[[nodiscard]] inline std::vector<Vec2> marker_keypoints(const SyntheticMarkerGrid& m) {
   std::vector<Vec2> out;
   const double h = 0.5 * m.marker_mm;
   for (int r = 0; r < m.rows; ++r) {

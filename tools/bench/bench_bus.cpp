@@ -32,7 +32,6 @@
 #include "drivers/serial/serial_port.h"
 #include "drivers/simdevice/device_thread.h"
 #include "drivers/simdevice/sim_arm.h"
-#include "drivers/simdevice/sim_clock.h"
 #include "drivers/simdevice/sense_to_command_tap.h"
 #include "drivers/simdevice/sim_hand.h"
 #include "core/plugin_host.h"
@@ -40,7 +39,7 @@
 
 namespace {
 using namespace crease::drivers;
-using sim::now_ns;
+using crease::rt::now_ns;
 
 struct Pct {
   double p50, p99, p999;

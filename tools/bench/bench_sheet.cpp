@@ -265,7 +265,7 @@ int run_sheet(int argc, char** argv) {
     }
   }
   const FoldScript truth = FoldScript::half_fold(p.grid);
-  const std::vector<Vec2> kps = marker_keypoints(MarkerLayout{});
+  const std::vector<Vec2> kps = marker_keypoints(SyntheticMarkerGrid{});
   const int nodes = p.grid.nodes_u * p.grid.nodes_v;
 
   p.solver.coupling = Coupling::springs;

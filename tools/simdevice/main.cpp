@@ -30,8 +30,8 @@
 #include "drivers/can/recording_can_bus.h"
 #include "drivers/serial/serial_port.h"
 #include "drivers/simdevice/sim_arm.h"
-#include "drivers/simdevice/sim_clock.h"
 #include "drivers/simdevice/sim_hand.h"
+#include "rt/clock.h"
 #include "drivers/simdevice/sim_tactile.h"
 
 namespace {
@@ -82,14 +82,14 @@ Args parse(int argc, char** argv) {
 // Runs step() until stopped; toggles silence on the schedule given by --silent-after/--silent-for.
 int serve(const Args& a, int fd, const std::function<void(std::int64_t)>& step,
           const std::function<void(bool)>& set_silent) {
-  const std::int64_t t0 = sim::now_ns();
+  const std::int64_t t0 = crease::rt::now_ns();
   const double seconds = a.num("seconds", 0);
   const double silent_after = a.num("silent-after", -1), silent_for = a.num("silent-for", 0);
   bool silent = false;
   while (!g_stop) {
     pollfd p{fd, POLLIN, 0};
     (void)::poll(&p, 1, 1);
-    const std::int64_t now = sim::now_ns();
+    const std::int64_t now = crease::rt::now_ns();
     const double t = static_cast<double>(now - t0) * 1e-9;
     if (seconds > 0 && t >= seconds) break;
     const bool want_silent = silent_after >= 0 && t >= silent_after && t < silent_after + silent_for;
@@ -146,9 +146,9 @@ int run(const Args& a) {
     broker.set_faults(f);
     std::printf("broker: %s\n", cfg.name.c_str());
     std::fflush(stdout);
-    const std::int64_t t0 = sim::now_ns();
+    const std::int64_t t0 = crease::rt::now_ns();
     const double seconds = a.num("seconds", 0);
-    while (!g_stop && (seconds <= 0 || static_cast<double>(sim::now_ns() - t0) * 1e-9 < seconds)) ::usleep(10'000);
+    while (!g_stop && (seconds <= 0 || static_cast<double>(crease::rt::now_ns() - t0) * 1e-9 < seconds)) ::usleep(10'000);
     return 0;
   }
   if (a.mode == "hand") {

@@ -225,6 +225,14 @@ TEST_CASE("plugin_dirs must exist when checked, resolved against the file's fold
     CHECK(e.loc().line == 1);
     CHECK(e.key_path() == "plugin_dirs[1]");
   }
+  // The loader's errors are Crease's one ConfigError: what creased and plugins catch.
+  static_assert(std::is_same_v<cfg::ConfigError, crease::ConfigError>);
+  try {
+    (void)cfg::load_daemon_config(file);
+    FAIL("expected a ConfigError");
+  } catch (const crease::Error& e) {
+    CHECK(std::string(e.what()).find("plugin_dirs[1]") != std::string::npos);
+  }
   {
     std::ofstream out(file);
     out << "plugin_dirs: [plugins]\nloops: [{name: a, rate_hz: 1, priority: 0}]\n";

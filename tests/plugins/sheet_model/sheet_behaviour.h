@@ -148,7 +148,7 @@ TEST_CASE("coupling pulls the sheet onto a rigid motion of itself") {
     CHECK(all_finite(*s));
     return e;
   };
-  const auto markers = marker_keypoints(MarkerLayout{});
+  const auto markers = marker_keypoints(SyntheticMarkerGrid{});
   SUBCASE("seed 001 Eq. 4: zero-length springs to sheet points") {
     const double e = max_error(
         [&](SheetModel& s, auto&& f) {
@@ -175,7 +175,7 @@ TEST_CASE("coupling pulls the sheet onto a rigid motion of itself") {
 
 TEST_CASE("hostile inputs keep the state finite") {
   auto s = make_sheet(SheetParams{});
-  const auto markers = marker_keypoints(MarkerLayout{});
+  const auto markers = marker_keypoints(SyntheticMarkerGrid{});
   std::vector<KeypointObs> k;
   std::vector<TargetPoint> t;
   for (Vec2 m : markers) {
@@ -247,7 +247,7 @@ TEST_CASE("through the half fold no node passes through the other layer") {
   f.keys[1] = {5.0, 200.0};
   f.keys[2] = {7.0, 200.0};
   script.add(f);
-  const auto markers = marker_keypoints(MarkerLayout{});
+  const auto markers = marker_keypoints(SyntheticMarkerGrid{});
   std::vector<KeypointObs> k;
   const Grid& g = s->grid();
   double min_gap = 1e9;
@@ -281,7 +281,7 @@ TEST_CASE("no allocation per step") {
   SheetParams p;
   auto s = make_sheet(p);
   s->set_collision_world(&world);
-  const auto markers = marker_keypoints(MarkerLayout{});
+  const auto markers = marker_keypoints(SyntheticMarkerGrid{});
   std::vector<KeypointObs> k;
   std::vector<TargetPoint> t;
   for (Vec2 m : markers) {

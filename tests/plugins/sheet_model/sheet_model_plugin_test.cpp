@@ -117,7 +117,7 @@ double mean_z_after_lift(const char* params) {
   host.add_instance(s);
   auto* kp_port = host.ports().bind_latest_writer("keypoints", crease::port_type_of<crease::Keypoints>(), "test");
   auto kp = std::make_unique<crease::Keypoints>();
-  const auto layout = crease::sheet::marker_keypoints(crease::sheet::MarkerLayout{});
+  const auto layout = crease::sheet::marker_keypoints(crease::sheet::SyntheticMarkerGrid{});
   kp->count = static_cast<std::uint32_t>(layout.size());
   for (std::size_t i = 0; i < layout.size(); ++i) {
     const auto& m = layout[i];  // flat sheet: (u, 297 - v, 0.5) in world mm

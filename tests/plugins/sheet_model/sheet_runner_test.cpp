@@ -21,7 +21,7 @@ constexpr std::int64_t kFrameNs = 16'666'667;
 
 // Key-points of the analytic half fold at time t (marker ids 0..34, corner 0..4).
 const std::vector<Vec2>& kps_layout() {
-  static const std::vector<Vec2> kps = marker_keypoints(MarkerLayout{});
+  static const std::vector<Vec2> kps = marker_keypoints(SyntheticMarkerGrid{});
   return kps;
 }
 

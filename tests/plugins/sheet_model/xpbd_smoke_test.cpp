@@ -35,7 +35,7 @@ TEST_CASE("a short folded run touches every path and stays finite") {
   std::vector<Vec3> x(s.node_count());
   fold.node_positions(4.9, x);  // ~170 deg: the flap lies over the lower half
   s.set_positions(x);
-  const auto kps = marker_keypoints(MarkerLayout{});
+  const auto kps = marker_keypoints(SyntheticMarkerGrid{});
   KeypointPredictor pred(static_cast<int>(kps.size()));
   std::vector<TargetPoint> targets(kps.size());
   std::vector<KeypointObs> obs;
@@ -107,7 +107,7 @@ TEST_CASE("the AVX2 target and per-node passes agree with the scalar ones") {
   XpbdSheet a(p), b(p);
   b.force_scalar_passes(true);
   const FoldScript fold = FoldScript::half_fold(p.grid);
-  const auto kps = marker_keypoints(MarkerLayout{});
+  const auto kps = marker_keypoints(SyntheticMarkerGrid{});
   std::vector<TargetPoint> targets;
   for (const Vec2& k : kps) targets.push_back({fold.position(k, 2.0), k});
   a.set_targets(targets);
