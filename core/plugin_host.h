@@ -92,6 +92,7 @@ class PluginHost {
   void poll();
 
   [[nodiscard]] PortRegistry& ports() noexcept { return ports_; }
+  [[nodiscard]] const PortRegistry& ports() const noexcept { return ports_; }
   [[nodiscard]] std::vector<InstanceInfo> instances() const;
   [[nodiscard]] std::vector<const Loop*> loops() const;
   [[nodiscard]] std::vector<HostEvent> events() const;  // the whole timeline so far

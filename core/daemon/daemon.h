@@ -1,5 +1,7 @@
 // creased's body: builds the plugin host from a validated configuration, runs it until told
-// to stop, answers control requests, prints progress and the final summary, writes reports.
+// to stop (signals, `stop`, duration, safety policy), dispatches control requests to the
+// command handlers (commands/), and at the end prints the summary (console.h) and writes the
+// reports (report_builder.h).
 #pragma once
 
 #include <atomic>
@@ -45,14 +47,7 @@ class Daemon final : public control::RequestHandler {
   [[nodiscard]] PluginHost& host() noexcept { return *host_; }
 
  private:
-  nlohmann::json status() const;
-  nlohmann::json loops_json() const;
-  nlohmann::json plugins_json() const;
-  nlohmann::json ports_json() const;
-  nlohmann::json stats_json() const;
   void print_progress(double t_s);
-  void print_summary() const;
-  void write_reports() const;
 
   config::DaemonConfig config_;
   Options options_;

@@ -1,9 +1,15 @@
 #include "core/daemon/report_builder.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
+
+#include <spdlog/spdlog.h>
 
 #include "core/report/from_rt.h"
+#include "core/report/render.h"
 #include "rt/clock.h"
 
 namespace crease::daemon {
@@ -79,6 +85,22 @@ report::TimingReport build_report(const PluginHost& host, const RunFacts& facts)
     r.events.push_back({e.time_ns, event_kind(e.type), e.loop, e.instance, e.detail});
   }
   return r;
+}
+
+void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  const report::TimingReport r = build_report(host, facts);
+  for (const auto& [format, name] : {std::pair{report::Format::html, "report.html"}, std::pair{report::Format::json, "report.json"},
+                                     std::pair{report::Format::text, "report.txt"}}) {
+    const fs::path p = fs::path(dir) / name;
+    std::ofstream f(p);
+    f << report::render(r, format);
+    if (!f) spdlog::error("cannot write report {}", p.string());
+  }
+  std::printf("  reports: %s/report.{html,json,txt}\n", fs::absolute(dir).string().c_str());
+  std::fflush(stdout);
 }
 
 }  // namespace crease::daemon

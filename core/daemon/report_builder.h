@@ -1,4 +1,5 @@
-// Builds the timing report (core/report) from the running host: loops, plugins, events.
+// Builds the timing report (core/report) from the running host: loops, plugins, events; and
+// writes it where creased leaves it at exit.
 // Non-RT; reads the RT histograms through snapshots.
 #pragma once
 
@@ -18,5 +19,9 @@ struct RunFacts {
 };
 
 [[nodiscard]] report::TimingReport build_report(const PluginHost& host, const RunFacts& facts);
+
+// Writes DIR/report.{html,json,txt} (DIR created when missing) and prints where they are; a
+// file that cannot be written is logged, the others are still written.
+void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir);
 
 }  // namespace crease::daemon

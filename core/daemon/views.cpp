@@ -1,0 +1,87 @@
+#include "core/daemon/views.h"
+
+namespace crease::daemon {
+namespace {
+double us(std::uint64_t ns) { return double(ns) / 1000.0; }
+}  // namespace
+
+nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns) {
+  return {{"state", "running"},
+          {"config", facts.config_file},
+          {"uptime_s", double(now_ns - facts.start_ns) * 1e-9},
+          {"loops", host.loops().size()},
+          {"plugins", host.instances().size()},
+          {"faults", host.fault_count()},
+          {"sched_fifo", facts.sched_fifo_applied},
+          {"mlockall", facts.mlockall_applied}};
+}
+
+nlohmann::json loops_view(const PluginHost& host) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Loop* l : host.loops()) {
+    const auto w = l->timing().wakeup_latency.snapshot();
+    const auto e = l->timing().execution.snapshot();
+    out.push_back({{"name", l->spec().name},
+                   {"rate_hz", l->spec().rate_hz},
+                   {"priority", l->spec().priority},
+                   {"cpu", l->spec().cpu},
+                   {"sched_fifo", l->fifo_applied()},
+                   {"cycles", l->timing().cycles.load()},
+                   {"overruns", l->timing().missed_periods.load()},
+                   {"missed_deadlines", l->timing().overruns.load()},
+                   {"wakeup_p50_us", us(w.percentile(50))},
+                   {"wakeup_p99_us", us(w.percentile(99))},
+                   {"wakeup_max_us", us(w.max_ns)},
+                   {"exec_p99_us", us(e.percentile(99))}});
+  }
+  return out;
+}
+
+nlohmann::json plugins_view(const PluginHost& host) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const InstanceInfo& i : host.instances()) {
+    nlohmann::json tunables = nlohmann::json::object();
+    for (const Tunable& t : i.tunables) tunables[t.key] = {{"value", t.value}, {"min", t.lo}, {"max", t.hi}};
+    const auto x = i.stats->execution.snapshot();
+    out.push_back({{"name", i.name},
+                   {"loop", i.loop},
+                   {"order", i.order},
+                   {"plugin", i.plugin},
+                   {"version", i.version},
+                   {"library", i.library},
+                   {"state", to_string(i.state)},
+                   {"last_fault", to_string(i.last_fault)},
+                   {"updates", i.stats->updates.load()},
+                   {"degraded", i.stats->degraded.load()},
+                   {"faults", i.stats->faults.load()},
+                   {"swaps", i.stats->swaps.load()},
+                   {"exec_p99_us", us(x.percentile(99))},
+                   {"tunables", tunables}});
+  }
+  return out;
+}
+
+nlohmann::json ports_view(const PortRegistry& ports) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const PortInfo& p : ports.list()) {
+    nlohmann::json j = {{"name", p.name},
+                        {"kind", p.kind == PortKind::latest ? "latest" : "queue"},
+                        {"type", p.type_name},
+                        {"version", p.type_version},
+                        {"size", p.size},
+                        {"writer", p.writer},
+                        {"readers", p.readers}};
+    if (p.kind == PortKind::latest) j["writes"] = p.sequence;
+    else j.update({{"capacity", p.capacity}, {"pushed", p.pushed}, {"dropped", p.dropped}});
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+nlohmann::json stats_view(const PluginHost& host, const control::ControlServer* server) {
+  return {{"control", server ? server->counters().to_json() : nlohmann::json()},
+          {"faults", host.fault_count()},
+          {"loops", loops_view(host)}};
+}
+
+}  // namespace crease::daemon

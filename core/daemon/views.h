@@ -1,0 +1,30 @@
+// The JSON views of a running host that the control commands `status`, `loops`, `plugins`,
+// `ports` and `stats` answer with (field names are part of the control protocol: README.md).
+// Non-RT; the counters are read as they are now (atomics, histogram snapshots).
+#pragma once
+
+#include <cstdint>
+
+#include <nlohmann/json.hpp>
+
+#include "core/control/control_server.h"
+#include "core/daemon/report_builder.h"
+#include "core/plugin_host.h"
+#include "core/port_registry.h"
+
+namespace crease::daemon {
+
+// State, configuration, uptime since facts.start_ns (now_ns: CLOCK_MONOTONIC), counts, and
+// whether SCHED_FIFO and mlockall were applied.
+[[nodiscard]] nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns);
+// Per loop: spec, cycles, overruns, wake-up and execution percentiles (us).
+[[nodiscard]] nlohmann::json loops_view(const PluginHost& host);
+// Per instance: plugin, library, state, counters, execution p99 (us), tunables.
+[[nodiscard]] nlohmann::json plugins_view(const PluginHost& host);
+// Per port: name, kind, type, version, size, writer, readers, and the kind's counters
+// (latest: writes; queue: capacity, pushed, dropped).
+[[nodiscard]] nlohmann::json ports_view(const PortRegistry& ports);
+// The control server's counters (null without a server), faults, and loops_view().
+[[nodiscard]] nlohmann::json stats_view(const PluginHost& host, const control::ControlServer* server);
+
+}  // namespace crease::daemon

@@ -1,0 +1,71 @@
+// The JSON views the read-only control commands answer with: every kind of port in `ports`
+// with its ends and counters, loops and plugins.
+#include "core/daemon/views.h"
+
+#include <doctest/doctest.h>
+
+namespace {
+struct Sample {
+  static constexpr char kPortType[] = "crease.test.Sample";
+  static constexpr std::uint32_t kPortVersion = 3;
+  double x;
+};
+
+const nlohmann::json& port_named(const nlohmann::json& ports, const std::string& name) {
+  for (const auto& p : ports)
+    if (p["name"] == name) return p;
+  FAIL("no port " << name);
+  static const nlohmann::json none;
+  return none;
+}
+}  // namespace
+
+TEST_CASE("ports lists latest and queue ports with their ends and counters") {
+  crease::PluginHost host({});
+  crease::PortRegistry& reg = host.ports();
+  const auto type = crease::port_type_of<Sample>();
+  crease::rt::LatestChannel* state = reg.bind_latest_writer("state", type, "model");
+  (void)reg.bind_latest_reader("state", type, "ctrl");
+  const Sample v{1.5};
+  state->write(&v, 10);
+  crease::rt::QueueChannel* q = reg.bind_queue_writer("events", type, "seq", 4);
+  (void)reg.bind_queue_reader("events", type, "model", 0);
+  for (int i = 0; i < 6; ++i) (void)q->try_push(&v);  // 4 fit, 2 dropped
+  const nlohmann::json ports = crease::daemon::ports_view(reg);
+  REQUIRE(ports.size() == 2);
+  const auto& l = port_named(ports, "state");
+  CHECK(l["kind"] == "latest");
+  CHECK(l["type"] == "crease.test.Sample");
+  CHECK(l["version"] == 3);
+  CHECK(l["size"] == sizeof(Sample));
+  CHECK(l["writer"] == "model");
+  CHECK(l["readers"] == nlohmann::json::array({"ctrl"}));
+  CHECK(l["writes"] == 1);
+  const auto& e = port_named(ports, "events");
+  CHECK(e["kind"] == "queue");
+  CHECK(e["capacity"] == 4);
+  CHECK(e["pushed"] == 4);
+  CHECK(e["dropped"] == 2);
+}
+
+TEST_CASE("status, loops and stats views of a host") {
+  crease::PluginHost host({});
+  host.add_loop({"control", 1000, 0, -1});
+  crease::daemon::RunFacts facts;
+  facts.config_file = "sim.yaml";
+  facts.start_ns = 1'000'000'000;
+  const auto s = crease::daemon::status_view(host, facts, 3'500'000'000);
+  CHECK(s["state"] == "running");
+  CHECK(s["config"] == "sim.yaml");
+  CHECK(s["uptime_s"] == doctest::Approx(2.5));
+  CHECK(s["loops"] == 1);
+  CHECK(s["plugins"] == 0);
+  const auto loops = crease::daemon::loops_view(host);
+  REQUIRE(loops.size() == 1);
+  CHECK(loops[0]["name"] == "control");
+  CHECK(loops[0]["rate_hz"] == 1000.0);
+  CHECK(crease::daemon::plugins_view(host).empty());
+  const auto stats = crease::daemon::stats_view(host, nullptr);
+  CHECK(stats["control"].is_null());
+  CHECK(stats["loops"] == loops);
+}
