@@ -1,6 +1,7 @@
 #include "core/params.h"
 
 #include <cstdio>
+#include <filesystem>
 
 namespace crease {
 
@@ -55,6 +56,18 @@ YAML::Node Params::lookup(std::string_view key, bool required) const {
   if (n && n.IsNull()) return YAML::Node();
   return n;
 }
+
+std::string Params::resolve_path(const std::string& value) const {
+  const std::filesystem::path v(value);
+  if (v.is_absolute()) return value;
+  return (std::filesystem::path(file_).parent_path() / v).string();
+}
+
+std::string Params::get_path(std::string_view key, const std::string& fallback) const {
+  return resolve_path(get<std::string>(key, fallback));
+}
+
+std::string Params::get_path(std::string_view key) const { return resolve_path(get<std::string>(key)); }
 
 Params Params::child(std::string_view key) const {
   const YAML::Node n = lookup(key, false);

@@ -52,6 +52,14 @@ class Params {
     return v;
   }
 
+  // A path: the string value (or the fallback), relative paths resolved against the folder of
+  // the file the parameters came from (the configuration's folder; the working directory for
+  // parameters of a control request).
+  [[nodiscard]] std::string get_path(std::string_view key, const std::string& fallback) const;
+  [[nodiscard]] std::string get_path(std::string_view key) const;  // required
+  // The same resolution for a path the plugin read itself (an item of a list).
+  [[nodiscard]] std::string resolve_path(const std::string& value) const;
+
   // A nested map (throws when present but not a map; empty when absent).
   [[nodiscard]] Params child(std::string_view key) const;
   // A list of maps, each element a Params named `key[i]` (throws when present but not a list of

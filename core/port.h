@@ -24,7 +24,9 @@
 
 namespace crease {
 
-enum class PortKind : std::uint8_t { latest, queue };
+// latest and queue carry payloads (below); frames carries camera images (core/frames, bound
+// through PortBinder::frames_output / frames_input).
+enum class PortKind : std::uint8_t { latest, queue, frames };
 
 // Runtime identity of a payload type (the registry copies the name).
 struct PortType {

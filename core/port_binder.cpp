@@ -37,6 +37,16 @@ std::optional<PortInfo> PortBinder::find(std::string_view port) const {
   return std::nullopt;
 }
 
+std::shared_ptr<frames::FrameChannel> PortBinder::frames_output(std::string_view port,
+                                                                const std::vector<frames::CameraSpec>& cameras) {
+  return registry_.bind_frames_writer(global_name(port), cameras, instance_);
+}
+
+std::shared_ptr<frames::FrameChannel> PortBinder::frames_input(std::string_view port,
+                                                               const std::vector<frames::CameraSpec>& cameras) {
+  return registry_.bind_frames_reader(global_name(port), cameras, instance_);
+}
+
 void PortBinder::tunable(std::string_view key, double* value, double lo, double hi) {
   const std::string k(key);
   if (value == nullptr || !(lo <= hi)) throw ConfigError("instance '" + instance_ + "': tunable '" + k + "' needs a target and lo <= hi");

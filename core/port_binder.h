@@ -60,6 +60,15 @@ class PortBinder {
     return QueueInput<T>(registry_.bind_queue_reader(global_name(port), port_type_of<T>(), instance_, capacity));
   }
 
+  // Binds the writing or reading end of a frame channel (camera images, core/frames) with the
+  // cameras of the plugin's rig, in set order: a port of kind `frames`, named and remapped like
+  // every port. The channel lives as long as the host; the worker thread that writes or reads
+  // it claims its end on the channel itself.
+  std::shared_ptr<frames::FrameChannel> frames_output(std::string_view port,
+                                                      const std::vector<frames::CameraSpec>& cameras);
+  std::shared_ptr<frames::FrameChannel> frames_input(std::string_view port,
+                                                     const std::vector<frames::CameraSpec>& cameras);
+
   // Declares a parameter that `param set` may change while the plugin runs. *value is written
   // between two updates, on the loop thread, after validate_param() accepted it and it lies in
   // [lo, hi]. The current *value is the initial one.

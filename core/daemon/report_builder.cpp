@@ -81,10 +81,41 @@ report::TimingReport build_report(const PluginHost& host, const RunFacts& facts)
     }
     r.loops.push_back(std::move(lt));
   }
+  r.ports = port_traffic(host.ports());
   for (const HostEvent& e : host.events()) {
     r.events.push_back({e.time_ns, event_kind(e.type), e.loop, e.instance, e.detail});
   }
   return r;
+}
+
+std::vector<report::PortTraffic> port_traffic(const PortRegistry& ports) {
+  std::vector<report::PortTraffic> out;
+  for (const PortInfo& p : ports.list()) {
+    report::PortTraffic t;
+    t.name = p.name;
+    t.kind = to_string(p.kind);
+    t.type = p.type_name;
+    t.version = p.type_version;
+    t.size = p.size;
+    t.writer = p.writer;
+    t.readers = p.readers;
+    t.cameras = p.cameras;
+    switch (p.kind) {
+      case PortKind::latest: t.writes = p.sequence; break;
+      case PortKind::queue:
+        t.capacity = p.capacity;
+        t.writes = p.pushed;
+        t.dropped = p.dropped;
+        break;
+      case PortKind::frames:
+        t.writes = p.sequence;
+        t.dropped = p.overwritten;
+        t.consumed = p.consumed;
+        break;
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
 }
 
 void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir) {

@@ -1,5 +1,5 @@
-// Builds the timing report (core/report) from the running host: loops, plugins, events; and
-// writes it where creased leaves it at exit.
+// Builds the timing report (core/report) from the running host: loops, plugins, ports (every
+// kind, frame channels too), events; and writes it where creased leaves it at exit.
 // Non-RT; reads the RT histograms through snapshots.
 #pragma once
 
@@ -19,6 +19,9 @@ struct RunFacts {
 };
 
 [[nodiscard]] report::TimingReport build_report(const PluginHost& host, const RunFacts& facts);
+
+// The ports as the report lists them: PortRegistry::list() with its counters now.
+[[nodiscard]] std::vector<report::PortTraffic> port_traffic(const PortRegistry& ports);
 
 // Writes DIR/report.{html,json,txt} (DIR created when missing) and prints where they are; a
 // file that cannot be written is logged, the others are still written.

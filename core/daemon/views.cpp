@@ -65,14 +65,22 @@ nlohmann::json ports_view(const PortRegistry& ports) {
   nlohmann::json out = nlohmann::json::array();
   for (const PortInfo& p : ports.list()) {
     nlohmann::json j = {{"name", p.name},
-                        {"kind", p.kind == PortKind::latest ? "latest" : "queue"},
+                        {"kind", to_string(p.kind)},
                         {"type", p.type_name},
                         {"version", p.type_version},
                         {"size", p.size},
                         {"writer", p.writer},
                         {"readers", p.readers}};
-    if (p.kind == PortKind::latest) j["writes"] = p.sequence;
-    else j.update({{"capacity", p.capacity}, {"pushed", p.pushed}, {"dropped", p.dropped}});
+    switch (p.kind) {
+      case PortKind::latest: j["writes"] = p.sequence; break;
+      case PortKind::queue: j.update({{"capacity", p.capacity}, {"pushed", p.pushed}, {"dropped", p.dropped}}); break;
+      case PortKind::frames:
+        j.update({{"cameras", p.cameras},
+                  {"published", p.sequence},
+                  {"consumed", p.consumed},
+                  {"overwritten", p.overwritten}});
+        break;
+    }
     out.push_back(std::move(j));
   }
   return out;

@@ -21,8 +21,9 @@ namespace crease::daemon {
 [[nodiscard]] nlohmann::json loops_view(const PluginHost& host);
 // Per instance: plugin, library, state, counters, execution p99 (us), tunables.
 [[nodiscard]] nlohmann::json plugins_view(const PluginHost& host);
-// Per port: name, kind, type, version, size, writer, readers, and the kind's counters
-// (latest: writes; queue: capacity, pushed, dropped).
+// Per port, every kind: name, kind, type, version, size, writer, readers, and the kind's
+// counters (latest: writes; queue: capacity, pushed, dropped; frames: cameras, published,
+// consumed, overwritten).
 [[nodiscard]] nlohmann::json ports_view(const PortRegistry& ports);
 // The control server's counters (null without a server), faults, and loops_view().
 [[nodiscard]] nlohmann::json stats_view(const PluginHost& host, const control::ControlServer* server);

@@ -1,32 +1,37 @@
 #include "core/frames/frame_channel.h"
 
 #include <set>
-#include <stdexcept>
+
+#include "core/assert.h"
 
 namespace crease::frames {
 
 FrameChannel::FrameChannel(std::string name, std::vector<CameraSpec> cameras)
     : name_(std::move(name)), cameras_(std::move(cameras)) {
-  if (cameras_.empty()) throw std::invalid_argument("frame channel '" + name_ + "': no cameras");
-  if (cameras_.size() > kMaxCameras)
-    throw std::invalid_argument("frame channel '" + name_ +
-                                "': " + std::to_string(cameras_.size()) + " cameras, at most " +
-                                std::to_string(kMaxCameras));
+  require_input(!cameras_.empty(), "frame channel '" + name_ + "': no cameras");
+  require_input(cameras_.size() <= kMaxCameras, "frame channel '" + name_ + "': " +
+                                                    std::to_string(cameras_.size()) +
+                                                    " cameras, at most " +
+                                                    std::to_string(kMaxCameras));
   std::set<std::string> names;
   for (const CameraSpec& c : cameras_) {
-    if (c.width <= 0 || c.height <= 0)
-      throw std::invalid_argument("frame channel '" + name_ + "': camera '" + c.name +
-                                  "' has size " + std::to_string(c.width) + "x" +
-                                  std::to_string(c.height));
-    if (!names.insert(c.name).second)
-      throw std::invalid_argument("frame channel '" + name_ + "': camera '" + c.name +
-                                  "' listed twice");
+    require_input(c.width > 0 && c.height > 0,
+                  "frame channel '" + name_ + "': camera '" + c.name + "' has size " +
+                      std::to_string(c.width) + "x" + std::to_string(c.height));
+    require_input(names.insert(c.name).second,
+                  "frame channel '" + name_ + "': camera '" + c.name + "' listed twice");
   }
   for (FrameSet& s : slots_) {
     for (std::size_t k = 0; k < cameras_.size(); ++k) {
       s.images_.push_back(std::make_unique<std::uint8_t[]>(image_bytes(k)));  // zeroed: touched now
     }
   }
+}
+
+std::size_t FrameChannel::set_bytes() const noexcept {
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < cameras_.size(); ++k) n += image_bytes(k);
+  return n;
 }
 
 std::uint32_t FrameChannel::all_cameras_mask() const noexcept {
@@ -70,7 +75,12 @@ std::uint64_t FrameChannel::publish(std::int64_t stamp_ns, std::uint64_t frame,
   s.valid_mask = valid_mask & all_cameras_mask();
   // Release: the pixels and header above; acquire: the set we get back was released by the
   // reader (it no longer reads it).
-  writer_ = middle_.exchange(writer_ | kFresh, std::memory_order_acq_rel) & kIndexMask;
+  const std::uint32_t was = middle_.exchange(writer_ | kFresh, std::memory_order_acq_rel);
+  writer_ = was & kIndexMask;
+  if ((was & kFresh) != 0) {  // the set we took back was published and never acquired
+    overwritten_.store(overwritten_.load(std::memory_order_relaxed) + 1,
+                       std::memory_order_release);
+  }
   published_.store(seq, std::memory_order_release);
   wake();
   return seq;

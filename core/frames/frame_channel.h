@@ -1,7 +1,9 @@
 // Frame channel: the newest set of camera images of one camera source, handed from the
 // source's worker thread to one consumer (the vision worker) without copying the pixels through
-// a port. Camera images are megabytes; a port carries only the announcement
-// (core/port_types/camera_frames.h).
+// a latest port. Camera images are megabytes; a latest port carries only the announcement
+// (core/port_types/camera_frames.h). The host's PortRegistry owns the channels, as ports of
+// kind `frames` (bound through PortBinder::frames_output / frames_input, listed with the other
+// ports); this class is the channel itself.
 //
 // A triple buffer of frame sets, every buffer allocated at construction: the writer fills its
 // private set (write_slot) and publishes it, which swaps it with the shared middle set; the
@@ -21,6 +23,8 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "core/errors.h"
 
 namespace crease::frames {
 
@@ -56,9 +60,13 @@ class FrameSet {
 class FrameChannel {
  public:
   static constexpr std::size_t kMaxCameras = 32;  // valid_mask bits
+  // The channel's type as ports list it (its cameras say the rest).
+  static constexpr char kTypeName[] = "crease.FrameSet";
+  static constexpr std::uint32_t kTypeVersion = 1;
 
-  // Allocates three frame sets (non-RT). Throws std::invalid_argument naming the channel when
-  // there are no cameras, more than kMaxCameras, duplicate names or a non-positive size.
+  // Allocates three frame sets (non-RT). Throws ConfigError naming the channel when there are
+  // no cameras, more than kMaxCameras, duplicate names or a non-positive size (the cameras
+  // come from calibration files).
   FrameChannel(std::string name, std::vector<CameraSpec> cameras);
   FrameChannel(const FrameChannel&) = delete;
   FrameChannel& operator=(const FrameChannel&) = delete;
@@ -69,6 +77,7 @@ class FrameChannel {
     return static_cast<std::size_t>(cameras_[camera].width) *
            static_cast<std::size_t>(cameras_[camera].height);
   }
+  [[nodiscard]] std::size_t set_bytes() const noexcept;  // pixels of one frame set, all cameras
   [[nodiscard]] std::uint32_t all_cameras_mask() const noexcept;
 
   // --- writer end (one holder at a time) ---
@@ -99,6 +108,11 @@ class FrameChannel {
   // Sequence of the newest set the reader acquired (0 = none).
   [[nodiscard]] std::uint64_t consumed() const noexcept {
     return consumed_.load(std::memory_order_acquire);
+  }
+  // Sets a publish replaced before the reader acquired them (the reader always takes the
+  // newest; these it never saw).
+  [[nodiscard]] std::uint64_t overwritten() const noexcept {
+    return overwritten_.load(std::memory_order_acquire);
   }
   // Sequence of the newest set the reader finished with (0 = none).
   [[nodiscard]] std::uint64_t finished() const noexcept {
@@ -133,6 +147,7 @@ class FrameChannel {
   // Each on its own cache line: the writer and the reader both swap with the middle.
   alignas(64) std::atomic<std::uint32_t> middle_{2};
   alignas(64) std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> overwritten_{0};  // written by the writer only
   alignas(64) std::atomic<std::uint64_t> consumed_{0};
   std::atomic<std::uint64_t> finished_{0};
   alignas(64) std::atomic<std::uint64_t> signal_{0};

@@ -1,6 +1,6 @@
 // Port payload `camera_frames`: a camera source announcing the frame set it just published.
-// The pixels do not travel on the port (megabytes per set): they are in the frame channel named
-// `channel` (core/frames/frame_registry.h), which the consumer opened at configure time.
+// The pixels do not travel on this port (megabytes per set): they are in the frame channel named
+// `channel` (core/frames, a port of kind `frames` that both ends bound at configure time).
 #pragma once
 
 #include <cstdint>

@@ -163,6 +163,23 @@ std::string render_text(const TimingReport& r) {
       append_percentiles(out, ("  execution " + p.name).c_str(), p.execution);
     }
   }
+  out += "# Ports\n";
+  for (const PortTraffic& p : r.ports) {
+    std::string readers;
+    for (const std::string& x : p.readers) readers += (readers.empty() ? "" : ",") + x;
+    appendf(out, "#   port %s (%s %s v%u, %" PRIu64 " bytes): writer=%s readers=%s writes=%" PRIu64
+            " dropped=%" PRIu64, p.name.c_str(), p.kind.c_str(), p.type.c_str(), p.version, p.size,
+            p.writer.empty() ? "-" : p.writer.c_str(), readers.empty() ? "-" : readers.c_str(), p.writes,
+            p.dropped);
+    if (p.kind == "queue") appendf(out, " capacity=%" PRIu64, p.capacity);
+    if (p.kind == "frames") {
+      appendf(out, " consumed=%" PRIu64 " cameras=", p.consumed);
+      for (std::size_t k = 0; k < p.cameras.size(); ++k) {
+        out += (k == 0 ? "" : ",") + one_line(p.cameras[k]);
+      }
+    }
+    out += '\n';
+  }
   out += "# Events\n";
   for (const Event& e : r.events) {
     appendf(out, "#   %.6f s %s loop=%s plugin=%s %s\n", (e.time_ns - r.start_ns) * 1e-9,

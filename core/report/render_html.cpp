@@ -233,6 +233,23 @@ std::string render_html(const TimingReport& r) {
     h += "</table>\n";
   }
 
+  h += "<h2>Ports</h2><table><tr><th class=\"l\">port</th><th class=\"l\">kind</th>"
+       "<th class=\"l\">type</th><th>bytes</th><th class=\"l\">writer</th><th class=\"l\">readers</th>"
+       "<th>writes</th><th>dropped</th><th>capacity</th><th>consumed</th><th class=\"l\">cameras</th></tr>";
+  for (const PortTraffic& p : r.ports) {
+    std::string readers, cameras;
+    for (const std::string& x : p.readers) readers += (readers.empty() ? "" : ", ") + x;
+    for (const std::string& c : p.cameras) cameras += (cameras.empty() ? "" : ", ") + c;
+    h += "<tr><td class=\"l\">" + esc(p.name) + "</td><td class=\"l\">" + esc(p.kind) + "</td><td class=\"l\">" +
+         esc(p.type) + " v" + std::to_string(p.version) + "</td><td>" + std::to_string(p.size) +
+         "</td><td class=\"l\">" + esc(p.writer) + "</td><td class=\"l\">" + esc(readers) + "</td><td>" +
+         std::to_string(p.writes) + "</td><td>" + std::to_string(p.dropped) + "</td><td>" +
+         (p.kind == "queue" ? std::to_string(p.capacity) : "") + "</td><td>" +
+         (p.kind == "frames" ? std::to_string(p.consumed) : "") + "</td><td class=\"l\">" + esc(cameras) +
+         "</td></tr>";
+  }
+  h += "</table>\n";
+
   h += "<h2>Events</h2><table><tr><th>time s</th><th class=\"l\">kind</th><th class=\"l\">loop"
        "</th><th class=\"l\">plugin</th><th class=\"l\">detail</th></tr>";
   for (const Event& e : r.events) {

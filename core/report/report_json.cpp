@@ -66,6 +66,18 @@ void from_json(const nlohmann::json& j, Event& v) {
   CREASE_J_IN(detail)
 }
 
+void to_json(nlohmann::json& j, const PortTraffic& v) {
+  j = nlohmann::json::object();
+  CREASE_J_OUT(name) CREASE_J_OUT(kind) CREASE_J_OUT(type) CREASE_J_OUT(version)
+  CREASE_J_OUT(size) CREASE_J_OUT(writer) CREASE_J_OUT(readers) CREASE_J_OUT(cameras)
+  CREASE_J_OUT(capacity) CREASE_J_OUT(writes) CREASE_J_OUT(dropped) CREASE_J_OUT(consumed)
+}
+void from_json(const nlohmann::json& j, PortTraffic& v) {
+  CREASE_J_IN(name) CREASE_J_IN(kind) CREASE_J_IN(type) CREASE_J_IN(version)
+  CREASE_J_IN(size) CREASE_J_IN(writer) CREASE_J_IN(readers) CREASE_J_IN(cameras)
+  CREASE_J_IN(capacity) CREASE_J_IN(writes) CREASE_J_IN(dropped) CREASE_J_IN(consumed)
+}
+
 void to_json(nlohmann::json& j, const MachineInfo& v) {
   j = nlohmann::json::object();
   CREASE_J_OUT(hostname) CREASE_J_OUT(kernel) CREASE_J_OUT(cpu_model) CREASE_J_OUT(cpu_count)
@@ -81,12 +93,14 @@ void from_json(const nlohmann::json& j, MachineInfo& v) {
 void to_json(nlohmann::json& j, const TimingReport& v) {
   j = nlohmann::json::object();
   CREASE_J_OUT(title) CREASE_J_OUT(config_file) CREASE_J_OUT(start_ns) CREASE_J_OUT(end_ns)
-  CREASE_J_OUT(wall_clock) CREASE_J_OUT(machine) CREASE_J_OUT(loops) CREASE_J_OUT(events)
+  CREASE_J_OUT(wall_clock) CREASE_J_OUT(machine) CREASE_J_OUT(loops) CREASE_J_OUT(ports)
+  CREASE_J_OUT(events)
   j["duration_s"] = v.duration_s();
 }
 void from_json(const nlohmann::json& j, TimingReport& v) {
   CREASE_J_IN(title) CREASE_J_IN(config_file) CREASE_J_IN(start_ns) CREASE_J_IN(end_ns)
-  CREASE_J_IN(wall_clock) CREASE_J_IN(machine) CREASE_J_IN(loops) CREASE_J_IN(events)
+  CREASE_J_IN(wall_clock) CREASE_J_IN(machine) CREASE_J_IN(loops) CREASE_J_IN(ports)
+  CREASE_J_IN(events)
 }
 
 }  // namespace crease::report

@@ -72,6 +72,23 @@ struct Event {
   std::string detail;
 };
 
+// A port as it was when the report was made: what it carries, who writes and reads it, and
+// its traffic. Every kind: latest and queue ports, and frame channels (kind "frames").
+struct PortTraffic {
+  std::string name;
+  std::string kind;                  // "latest", "queue" or "frames"
+  std::string type;                  // payload type name (frames: crease.FrameSet)
+  std::uint32_t version = 0;
+  std::uint64_t size = 0;            // bytes of one payload (frames: of one set's pixels)
+  std::string writer;                // instance name; empty while unbound
+  std::vector<std::string> readers;  // instance names
+  std::vector<std::string> cameras;  // frames: "NAME WIDTHxHEIGHT" per camera
+  std::uint64_t capacity = 0;        // queue: records
+  std::uint64_t writes = 0;          // latest: writes; queue: pushed; frames: sets published
+  std::uint64_t dropped = 0;         // queue: refused when full; frames: sets overwritten unread
+  std::uint64_t consumed = 0;        // frames: sequence of the newest set the reader took
+};
+
 struct MachineInfo {
   std::string hostname;
   std::string kernel;       // uname -r + version
@@ -95,7 +112,8 @@ struct TimingReport {
   std::string wall_clock;     // human-readable time of the report (e.g. ISO 8601), optional
   MachineInfo machine;
   std::vector<LoopTiming> loops;
-  std::vector<Event> events;  // by time
+  std::vector<PortTraffic> ports;  // by name
+  std::vector<Event> events;       // by time
 
   [[nodiscard]] double duration_s() const noexcept { return double(end_ns - start_ns) * 1e-9; }
 };

@@ -1,13 +1,11 @@
 // The common part of the camera source plugins (camera_sim, camera_replay, camera_v4l2):
-// a CameraSource on a CameraWorker publishing into the frame channel `channel`
-// (core/frames), and the `frames` port (crease::CameraFrames) announcing each published set.
+// a CameraSource on a CameraWorker publishing into the frame channel of the `images` port
+// (images_port.h), and the `frames` port (crease::CameraFrames) announcing each published set.
 // Compiled into each camera plugin library (header-only: plugins share no code at run time
 // except through core).
 //
-// Common parameters:
-//   channel: NAME        frame channel the vision plugin reads (default "cameras")
-//   record: DIR          write every grabbed frame in the replay layout (paths relative to the
-//                        configuration file's folder)
+// Common parameters (paths relative to the configuration file's folder, Params::get_path):
+//   record: DIR          write every grabbed frame in the replay layout
 //   lockstep: bool       grab the next frame only once the reader finished the last one
 //                        (default true: capture and detection take turns, as one thread did
 //                        before the split, so the newest frame is grabbed when detection can
@@ -20,14 +18,13 @@
 
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "camera_worker.h"
-#include "core/frames/frame_registry.h"
 #include "core/plugin.h"
 #include "core/port_types/camera_frames.h"
+#include "images_port.h"
 
 namespace crease::vision {
 
@@ -74,27 +71,14 @@ class CameraPlugin : public crease::Plugin {
   void cleanup() override { worker_.reset(); }
 
  protected:
-  // Paths in parameters are relative to the configuration file's folder.
-  static std::string path_param(const crease::Params& p, const std::string& value) {
-    if (std::filesystem::path(value).is_absolute()) return value;
-    return (std::filesystem::path(p.file()).parent_path() / value).string();
-  }
-
   // Call last in configure, with the source the parameters describe.
   void configure_camera(const crease::Params& p, crease::PortBinder& ports,
                         std::unique_ptr<CameraSource> source, bool lockstep_default = true) {
-    const std::string name = p.get<std::string>("channel", "cameras");
-    if (name.empty() || name.size() >= crease::CameraFrames::kChannelNameCapacity)
-      p.fail("channel", "expected a name of 1.." +
-                            std::to_string(crease::CameraFrames::kChannelNameCapacity - 1) +
-                            " characters");
     lockstep_ = p.get<bool>("lockstep", lockstep_default);
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
-    const std::string record =
-        p.has("record") ? path_param(p, p.get<std::string>("record")) : std::string();
-    channel_ =
-        crease::frames::FrameRegistry::instance().open(name, channel_specs(source->cameras()));
-    std::memcpy(announce_.channel, name.c_str(), name.size() + 1);
+    const std::string record = p.has("record") ? p.get_path("record") : std::string();
+    channel_ = bind_images(ports, source->cameras(), ImagesEnd::writer);
+    std::memcpy(announce_.channel, channel_->name().c_str(), channel_->name().size() + 1);
     announce_.cameras = static_cast<std::uint32_t>(source->cameras().size());
     out_ = ports.latest_output<crease::CameraFrames>("frames", crease::CameraFrames{});
     worker_ = std::make_unique<CameraWorker>(std::move(source), channel_, record);

@@ -10,8 +10,7 @@ namespace {
 class CameraReplayPlugin final : public crease::vision::CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
-    auto src = std::make_unique<crease::vision::ReplaySource>(
-        path_param(p, p.get<std::string>("replay_dir")));
+    auto src = std::make_unique<crease::vision::ReplaySource>(p.get_path("replay_dir"));
     configure_camera(p, ports, std::move(src));
   }
 };

@@ -21,8 +21,8 @@ class CameraSimPlugin final : public CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     const MarkerLayout layout =
-        load_layout(path_param(p, p.get<std::string>("layout", "markers/layout.yaml")));
-    auto cams = load_camera_dir(path_param(p, p.get<std::string>("cameras", "cameras")));
+        load_layout(p.get_path("layout", "markers/layout.yaml"));
+    auto cams = load_camera_dir(p.get_path("cameras", "cameras"));
     const double ppm = 8.0;
     auto renderer = std::make_shared<const ViewRenderer>(
         face_texture(layout, Face::kFront, ppm), face_texture(layout, Face::kBack, ppm), ppm, cams);

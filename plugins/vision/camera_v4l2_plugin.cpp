@@ -19,11 +19,11 @@ using namespace crease::vision;
 class CameraV4l2Plugin final : public CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
-    auto cams = load_camera_dir(path_param(p, p.get<std::string>("cameras", "cameras")));
+    auto cams = load_camera_dir(p.get_path("cameras", "cameras"));
     std::vector<std::string> devices;
     const YAML::Node d = p.raw("devices");
     if (!d || !d.IsSequence()) p.fail("devices", "expected a list of video devices");
-    for (const auto& n : d) devices.push_back(path_param(p, n.as<std::string>()));
+    for (const auto& n : d) devices.push_back(p.resolve_path(n.as<std::string>()));
     if (devices.size() != cams.size())
       p.fail("devices", std::to_string(devices.size()) + " devices for " +
                             std::to_string(cams.size()) + " calibrations");

@@ -1,32 +1,30 @@
 // Plugin `vision`: marker detection and N-view triangulation of the frame sets a camera source
 // plugin (camera_sim, camera_replay, camera_v4l2) publishes -> `keypoints` port.
-// The images come through the frame channel `channel` (core/frames), not through a port:
-// five 1280x960 images are 6 MB a set. The `frames` port (crease::CameraFrames) carries the
-// source's announcement. Detection and triangulation run on a worker thread woken by each
+// The images come through the frame channel of the `images` port (images_port.h, kind
+// `frames`), not through a latest port: five 1280x960 images are 6 MB a set. The `frames`
+// port (crease::CameraFrames) carries the source's announcement. Detection and triangulation run on a worker thread woken by each
 // publish (VisionWorker); update() only copies the newest key-points out: no allocation, no
 // lock, no wait.
 //
 // Parameters (paths relative to the configuration file's folder):
 //   cameras: DIR of cam0.yaml.. (the calibrations of the channel's cameras, in order; for a
-//            replay, the recording's folder)        channel: NAME (default "cameras")
+//            replay, the recording's folder)
 //   layout: layout.yaml     decimate, full_search_interval; max_reproj_px, refine; stale_cycles
 //   camera_threads: 0 (default: cameras detected in parallel by OpenCV's pool) or N >= 1 (one
 //            task per camera on the worker and N-1 helper threads of ours, task_team.h; OpenCV's
 //            loops inside each detection still use its pool unless cv::setNumThreads(1))
-// Inputs: frames (crease::CameraFrames). Outputs: keypoints (crease::Keypoints).
+// Inputs: images (frames), frames (crease::CameraFrames). Outputs: keypoints (crease::Keypoints).
 // Status: degraded when a camera delivered nothing, no new key-points came for
 // `stale_cycles` cycles, or the source ended; fault if the worker failed.
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <memory>
 #include <string>
 
-#include "camera_worker.h"
-#include "core/frames/frame_registry.h"
 #include "core/plugin.h"
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
+#include "images_port.h"
 #include "vision_worker.h"
 
 namespace {
@@ -36,13 +34,8 @@ using namespace crease::vision;
 class VisionPlugin final : public crease::Plugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
-    const std::filesystem::path base = std::filesystem::path(p.file()).parent_path();
-    auto path = [&](const std::string& v) {
-      return std::filesystem::path(v).is_absolute() ? v : (base / v).string();
-    };
-    const MarkerLayout layout =
-        load_layout(path(p.get<std::string>("layout", "markers/layout.yaml")));
-    auto cams = load_camera_dir(path(p.get<std::string>("cameras", "cameras")));
+    const MarkerLayout layout = load_layout(p.get_path("layout", "markers/layout.yaml"));
+    auto cams = load_camera_dir(p.get_path("cameras", "cameras"));
     DetectorConfig det;
     det.decimate = p.get_in_range<int>("decimate", 2, 1, 4);
     det.full_search_interval = p.get_in_range<int>("full_search_interval", 8, 1, 1000);
@@ -51,15 +44,11 @@ class VisionPlugin final : public crease::Plugin {
     tri.refine = p.get<bool>("refine", true);
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
     const int camera_threads = p.get_in_range<int>("camera_threads", 0, 0, 64);
-    const std::string name = p.get<std::string>("channel", "cameras");
-    if (name.empty() || name.size() >= crease::CameraFrames::kChannelNameCapacity)
-      p.fail("channel", "expected a name of 1.." +
-                            std::to_string(crease::CameraFrames::kChannelNameCapacity - 1) +
-                            " characters");
-    std::memcpy(channel_name_, name.c_str(), name.size() + 1);
-    // Opens (or creates) the channel with these calibrations' cameras: a source with other
-    // cameras fails to configure with a message naming the channel and the camera.
-    auto channel = crease::frames::FrameRegistry::instance().open(name, channel_specs(cams));
+    // Binds the channel with these calibrations' cameras: a source with other cameras fails
+    // to configure (this end or the source, whichever binds second) with a message naming the
+    // channel and the camera.
+    auto channel = bind_images(ports, cams, ImagesEnd::reader);
+    std::memcpy(channel_name_, channel->name().c_str(), channel->name().size() + 1);
     buf_ = std::make_unique<crease::Keypoints>();
     frames_in_ = ports.latest_input<crease::CameraFrames>("frames");
     out_ = ports.latest_output<crease::Keypoints>("keypoints", crease::Keypoints{});

@@ -71,3 +71,18 @@ TEST_CASE("a list of maps: each element named by its index, its unread keys repo
 TEST_CASE("a non-map is refused") {
   CHECK(error_of([] { parse("[1, 2]"); }).find("expected a map of parameters") != std::string::npos);
 }
+
+TEST_CASE("paths resolve against the folder of the file the parameters came from") {
+  const crease::Params p(YAML::Load("layout: markers/layout.yaml\nrecord: /tmp/rec\n"), "/etc/crease/sim.yaml",
+                         "plugins[0].params");
+  CHECK(p.get_path("layout") == "/etc/crease/markers/layout.yaml");
+  CHECK(p.get_path("record") == "/tmp/rec");
+  CHECK(p.get_path("cameras", "cameras") == "/etc/crease/cameras");
+  CHECK(p.resolve_path("cam0/%06d.png") == "/etc/crease/cam0/%06d.png");
+  CHECK(p.unused_keys().empty());  // read as paths, they count as read
+  CHECK(error_of([&] { (void)p.get_path("replay_dir"); }).find("params.replay_dir: required parameter is missing") !=
+        std::string::npos);
+  // A control request's parameters have no file: relative to the working directory.
+  const crease::Params r(YAML::Load("dir: rec"), "request", "cameras.params");
+  CHECK(r.get_path("dir") == "rec");
+}

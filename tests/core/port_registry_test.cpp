@@ -74,3 +74,71 @@ TEST_CASE("queues have one reader and a capacity") {
   reg.release("seq");
   CHECK(reg.list()[0].writer.empty());
 }
+
+TEST_CASE("frame channels are ports of kind frames: one channel per name, typed by its cameras") {
+  using crease::frames::CameraSpec;
+  const std::vector<CameraSpec> rig = {{"cam0", 8, 4}, {"cam1", 6, 3}};
+  crease::PortRegistry reg;
+  CHECK(reg.find_frames("images") == nullptr);
+  // The reader may bind first; both ends get the same channel, named like the port.
+  auto r = reg.bind_frames_reader("images", rig, "vision");
+  auto w = reg.bind_frames_writer("images", rig, "cameras");
+  CHECK(r.get() == w.get());
+  CHECK(reg.find_frames("images").get() == w.get());
+  CHECK(w->name() == "images");
+  CHECK(reg.find_latest("images") == nullptr);
+
+  w->publish(1, 1, 0x3);
+  w->publish(2, 2, 0x3);  // the first set is replaced unread
+  REQUIRE(r->acquire_newest() != nullptr);
+  const auto ports = reg.list();
+  REQUIRE(ports.size() == 1);
+  const crease::PortInfo& p = ports[0];
+  CHECK(p.kind == crease::PortKind::frames);
+  CHECK(std::string(crease::to_string(p.kind)) == "frames");
+  CHECK(p.type_name == "crease.FrameSet");
+  CHECK(p.type_version == 1);
+  CHECK(p.size == 8 * 4 + 6 * 3);
+  CHECK(p.writer == "cameras");
+  CHECK(p.readers == std::vector<std::string>{"vision"});
+  CHECK(p.cameras == std::vector<std::string>{"cam0 8x4", "cam1 6x3"});
+  CHECK(p.sequence == 2);
+  CHECK(p.consumed == 2);
+  CHECK(p.overwritten == 1);
+
+  // A hot swap rebinds under the same instance name; release forgets the roles, the channel stays.
+  CHECK(error_of([&] { (void)reg.bind_frames_writer("images", rig, "cameras"); }) == "no error");
+  reg.release("vision");
+  CHECK(reg.list()[0].readers.empty());
+  CHECK(reg.find_frames("images").get() == w.get());
+}
+
+TEST_CASE("frame channel mismatches name both ends and the camera") {
+  using crease::frames::CameraSpec;
+  const std::vector<CameraSpec> rig = {{"cam0", 8, 4}, {"cam1", 6, 3}};
+  crease::PortRegistry reg;
+  (void)reg.bind_frames_writer("images", rig, "cameras");
+  auto other = rig;
+  other[1].width = 7;
+  CHECK(error_of([&] { (void)reg.bind_frames_reader("images", other, "vision"); }) ==
+        "port 'images': instance 'vision' reads camera 1 as 'cam1' 7x3, but instance 'cameras' writes it as "
+        "'cam1' 6x3");
+  CHECK(error_of([&] { (void)reg.bind_frames_reader("images", {{"cam0", 8, 4}}, "vision"); }) ==
+        "port 'images': instance 'vision' reads 1 cameras, but instance 'cameras' writes 2");
+  CHECK(error_of([&] { (void)reg.bind_frames_writer("images", rig, "replay"); }).find("single writer") !=
+        std::string::npos);
+  (void)reg.bind_frames_reader("images", rig, "vision");
+  CHECK(error_of([&] { (void)reg.bind_frames_reader("images", rig, "vision2"); }) ==
+        "port 'images': instance 'vision2' cannot read it: instance 'vision' already does (frame channels have a "
+        "single reader)");
+  // One namespace for every kind of port.
+  reg.bind_latest_writer("state", port_type_of<A>(), "model");
+  CHECK(error_of([&] { (void)reg.bind_frames_reader("state", rig, "vision"); }) ==
+        "port 'state': instance 'vision' reads it as a frames port, but instance 'model' writes it as a latest port");
+  CHECK(error_of([&] { reg.bind_latest_reader("images", port_type_of<A>(), "ctrl"); }) ==
+        "port 'images': instance 'ctrl' reads it as a latest port, but instance 'cameras' writes it as a frames port");
+  // A rig the channel cannot hold is refused before any port exists.
+  CHECK_THROWS_WITH_AS((void)reg.bind_frames_writer("bad", {{"a", 0, 4}}, "cameras"),
+                       doctest::Contains("'a' has size 0x4"), crease::ConfigError);
+  CHECK(reg.list().size() == 2);
+}

@@ -1,5 +1,5 @@
 // The JSON views the read-only control commands answer with: every kind of port in `ports`
-// with its ends and counters, loops and plugins.
+// (frame channels with their cameras, writer, readers and counters), loops and plugins.
 #include "core/daemon/views.h"
 
 #include <doctest/doctest.h>
@@ -20,7 +20,7 @@ const nlohmann::json& port_named(const nlohmann::json& ports, const std::string&
 }
 }  // namespace
 
-TEST_CASE("ports lists latest and queue ports with their ends and counters") {
+TEST_CASE("ports lists latest, queue and frames ports with their ends and counters") {
   crease::PluginHost host({});
   crease::PortRegistry& reg = host.ports();
   const auto type = crease::port_type_of<Sample>();
@@ -31,8 +31,15 @@ TEST_CASE("ports lists latest and queue ports with their ends and counters") {
   crease::rt::QueueChannel* q = reg.bind_queue_writer("events", type, "seq", 4);
   (void)reg.bind_queue_reader("events", type, "model", 0);
   for (int i = 0; i < 6; ++i) (void)q->try_push(&v);  // 4 fit, 2 dropped
+  auto images = reg.bind_frames_writer("images", {{"cam0", 4, 2}, {"cam1", 2, 2}}, "cameras");
+  auto reader = reg.bind_frames_reader("images", {{"cam0", 4, 2}, {"cam1", 2, 2}}, "vision");
+  images->publish(1, 1, 0x3);
+  images->publish(2, 2, 0x3);
+  images->publish(3, 3, 0x3);
+  REQUIRE(reader->acquire_newest() != nullptr);
+
   const nlohmann::json ports = crease::daemon::ports_view(reg);
-  REQUIRE(ports.size() == 2);
+  REQUIRE(ports.size() == 3);
   const auto& l = port_named(ports, "state");
   CHECK(l["kind"] == "latest");
   CHECK(l["type"] == "crease.test.Sample");
@@ -46,6 +53,18 @@ TEST_CASE("ports lists latest and queue ports with their ends and counters") {
   CHECK(e["capacity"] == 4);
   CHECK(e["pushed"] == 4);
   CHECK(e["dropped"] == 2);
+  const auto& f = port_named(ports, "images");
+  CHECK(f["kind"] == "frames");
+  CHECK(f["type"] == "crease.FrameSet");
+  CHECK(f["version"] == 1);
+  CHECK(f["size"] == 4 * 2 + 2 * 2);
+  CHECK(f["writer"] == "cameras");
+  CHECK(f["readers"] == nlohmann::json::array({"vision"}));
+  CHECK(f["cameras"] == nlohmann::json::array({"cam0 4x2", "cam1 2x2"}));
+  CHECK(f["published"] == 3);
+  CHECK(f["consumed"] == 3);
+  CHECK(f["overwritten"] == 2);
+  CHECK_FALSE(f.contains("writes"));
 }
 
 TEST_CASE("status, loops and stats views of a host") {

@@ -1,18 +1,17 @@
-// Frame channel and registry: newest-set hand-over, one writer / one reader, no allocation on
-// publish or acquire, and configuration errors that name the channel.
+// Frame channel: newest-set hand-over, sets overwritten unread counted, one writer / one
+// reader, no allocation on publish or acquire, and configuration errors that name the channel.
+// (Binding channels by name, as ports of kind frames: tests/core/port_registry_test.cpp.)
 #include "core/frames/frame_channel.h"
 
 #include <doctest/doctest.h>
 
 #include <cstring>
-#include <stdexcept>
 
-#include "core/frames/frame_registry.h"
+#include "core/errors.h"
 #include "rt/alloc_guard.h"
 
 using crease::frames::CameraSpec;
 using crease::frames::FrameChannel;
-using crease::frames::FrameRegistry;
 using crease::frames::FrameSet;
 
 namespace {
@@ -68,6 +67,27 @@ TEST_CASE("the reader gets the newest published set, once, with what the writer 
   CHECK(s->pixels(1)[0] == 10);
 }
 
+TEST_CASE("a set replaced before the reader took it is counted as overwritten") {
+  FrameChannel ch("t", two_cams());
+  CHECK(ch.set_bytes() == 8 * 4 + 6 * 3);
+  REQUIRE(ch.try_claim_writer());
+  REQUIRE(ch.try_claim_reader());
+  ch.publish(1, 1, 0x3);
+  CHECK(ch.overwritten() == 0);
+  ch.publish(2, 2, 0x3);  // set 1 was never acquired
+  CHECK(ch.overwritten() == 1);
+  REQUIRE(ch.acquire_newest() != nullptr);
+  ch.publish(3, 3, 0x3);  // set 2 was taken: nothing lost
+  CHECK(ch.overwritten() == 1);
+  ch.publish(4, 4, 0x3);
+  ch.publish(5, 5, 0x3);
+  CHECK(ch.overwritten() == 3);
+  const FrameSet* s = ch.acquire_newest();
+  REQUIRE(s != nullptr);
+  CHECK(s->sequence == 5);
+  CHECK(ch.published() == 5);
+}
+
 TEST_CASE("one writer and one reader at a time; releasing changes the signal") {
   FrameChannel ch("t", two_cams());
   REQUIRE(ch.try_claim_writer());
@@ -107,29 +127,15 @@ TEST_CASE("publish and acquire allocate nothing") {
   }
 }
 
-TEST_CASE("bad channels and mismatched opens name the channel and the camera") {
+TEST_CASE("bad rigs are configuration errors that name the channel and the camera") {
   CHECK_THROWS_WITH_AS(FrameChannel("empty", {}), doctest::Contains("'empty': no cameras"),
-                       std::invalid_argument);
+                       crease::ConfigError);
   CHECK_THROWS_WITH_AS(FrameChannel("z", {{"a", 0, 4}}), doctest::Contains("'a' has size 0x4"),
-                       std::invalid_argument);
+                       crease::ConfigError);
   CHECK_THROWS_WITH_AS(FrameChannel("d", {{"a", 2, 2}, {"a", 2, 2}}),
-                       doctest::Contains("listed twice"), std::invalid_argument);
+                       doctest::Contains("listed twice"), crease::ConfigError);
   std::vector<CameraSpec> many(33, CameraSpec{"", 1, 1});
   for (std::size_t k = 0; k < many.size(); ++k) many[k].name = "c" + std::to_string(k);
   CHECK_THROWS_WITH_AS(FrameChannel("m", many), doctest::Contains("at most 32"),
-                       std::invalid_argument);
-
-  FrameRegistry& r = FrameRegistry::instance();
-  CHECK(r.find("frame_channel_test.rig") == nullptr);
-  auto a = r.open("frame_channel_test.rig", two_cams());
-  auto b = r.open("frame_channel_test.rig", two_cams());
-  CHECK(a.get() == b.get());
-  CHECK(r.find("frame_channel_test.rig").get() == a.get());
-  auto other = two_cams();
-  other[1].width = 7;
-  CHECK_THROWS_WITH_AS((void)r.open("frame_channel_test.rig", other),
-                       doctest::Contains("camera 1 is 'cam1' 6x3, asked for 'cam1' 7x3"),
-                       std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)r.open("frame_channel_test.rig", {{"cam0", 8, 4}}),
-                       doctest::Contains("has 2 cameras"), std::invalid_argument);
+                       crease::ConfigError);
 }

@@ -108,8 +108,29 @@ TEST_CASE("JSON round-trips the model") {
   CHECK(back.loops[0].wakeup_latency.worst[0].cycle == 900);
   CHECK(back.loops[0].wakeup_latency.buckets.size() == 4);
   CHECK(back.events[1].detail == "NaN on output <out>");
+  REQUIRE(back.ports.size() == 3);
+  CHECK(back.ports[1].kind == "frames");
+  CHECK(back.ports[1].cameras.size() == 2);
+  CHECK(back.ports[1].dropped == 4);
+  CHECK(back.ports[0].capacity == 256);
   CHECK(rep::render_json(back) == text);
   CHECK_THROWS(nlohmann::json{{"title", "x"}}.get<rep::TimingReport>());
+}
+
+TEST_CASE("text and HTML list every port, frame channels with their cameras") {
+  const rep::TimingReport r = rep::testing::report_fixture();
+  const std::string text = rep::render_text(r);
+  CHECK(text.find("# Ports\n") != std::string::npos);
+  CHECK(text.find("#   port images (frames crease.FrameSet v1, 2457600 bytes): writer=cameras readers=vision "
+                  "writes=30 dropped=4 consumed=29 cameras=cam0 1280x960,cam1 1280x960\n") != std::string::npos);
+  CHECK(text.find("#   port crease (queue crease.SheetCreaseEvent v1, 32 bytes): writer=seq readers=sheet "
+                  "writes=5 dropped=1 capacity=256\n") != std::string::npos);
+  CHECK(text.find("#   port sheet_state (latest crease.SheetState v1, 360000 bytes): writer=sheet readers=ctrl "
+                  "writes=120 dropped=0\n") != std::string::npos);
+  const std::string html = rep::render_html(r);
+  CHECK(html.find("<h2>Ports</h2>") != std::string::npos);
+  CHECK(html.find("<td class=\"l\">images</td><td class=\"l\">frames</td>") != std::string::npos);
+  CHECK(html.find("cam0 1280x960, cam1 1280x960") != std::string::npos);
 }
 
 TEST_CASE("HTML is one self-contained file with inline SVG and escaped text") {

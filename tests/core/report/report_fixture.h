@@ -30,6 +30,15 @@ inline Distribution exec_fixture(std::int64_t base_ns) {
   return d;
 }
 
+// A latest port, a queue and a frame channel, as the daemon lists them.
+inline void ports_fixture(TimingReport& r) {
+  PortTraffic state{"sheet_state", "latest", "crease.SheetState", 1, 360000, "sheet", {"ctrl"}, {}, 0, 120, 0, 0};
+  PortTraffic crease{"crease", "queue", "crease.SheetCreaseEvent", 1, 32, "seq", {"sheet"}, {}, 256, 5, 1, 0};
+  PortTraffic images{"images",  "frames", "crease.FrameSet", 1, 2457600, "cameras", {"vision"},
+                     {"cam0 1280x960", "cam1 1280x960"}, 0, 30, 4, 29};
+  r.ports = {crease, images, state};
+}
+
 inline TimingReport report_fixture() {
   TimingReport r;
   r.title = "Crease timing report <test & \"quotes\">";
@@ -64,6 +73,7 @@ inline TimingReport report_fixture() {
   fill_percentiles(model.wakeup_latency);
   model.execution = exec_fixture(500000);
   r.loops = {control, model};
+  ports_fixture(r);
   r.events = {{1'500'000'000, "hot_swap", "control", "counter", "crease_counter 1.0 -> 1.1"},
               {2'500'000'000, "fault", "control", "faulty", "NaN on output <out>"}};
   return r;

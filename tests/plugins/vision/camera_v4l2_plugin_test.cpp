@@ -93,7 +93,7 @@ TEST_CASE("camera_v4l2: a camera that appears late or goes away is dark, then ba
   s.params = crease::Params(
       YAML::Load("{cameras: '" + (dir / "cams").string() + "', devices: ['" +
                  (dir / "a" / "%06d.png").string() + "', '" + (dir / "b" / "%06d.png").string() +
-                 "'], channel: v4l2_retry, stale_cycles: 100000, reconnect_initial_s: 0.02, "
+                 "'], stale_cycles: 100000, reconnect_initial_s: 0.02, "
                  "reconnect_max_s: 0.1}"),
       std::string(CREASE_SOURCE_DIR) + "/config/test.yaml", "cameras.params");
   loop.host.add_instance(s);
@@ -125,7 +125,7 @@ TEST_CASE("camera_v4l2: a camera that appears late or goes away is dark, then ba
   s.loop = "cams";
   s.params = crease::Params(
       YAML::Load("{cameras: '" + (dir / "cams").string() +
-                 "', devices: [/dev/video97, /dev/video98], channel: v4l2_bad, "
+                 "', devices: [/dev/video97, /dev/video98], "
                  "reconnect_initial_s: 2, reconnect_max_s: 1}"),
       std::string(CREASE_SOURCE_DIR) + "/config/test.yaml", "bad.params");
   CHECK_THROWS_WITH(bad.host.add_instance(s), doctest::Contains("reconnect_max_s"));

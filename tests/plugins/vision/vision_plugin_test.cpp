@@ -1,7 +1,8 @@
 // The camera source plugins (camera_replay, camera_sim, camera_v4l2) feeding the `vision`
 // plugin in a real loop: key-points on the `keypoints` port, frame sets through one frame
-// channel that both dlopen'd plugins (and this test) see; degraded, never stopped, when a
-// camera stops; a replay processed twice gives the same key-points; either end hot-swapped.
+// channel (the host's port of kind frames that both dlopen'd plugins bound, listed with the
+// other ports); degraded, never stopped, when a camera stops; a replay processed twice gives
+// the same key-points; either end hot-swapped.
 #include <doctest/doctest.h>
 
 #include <chrono>
@@ -10,7 +11,7 @@
 #include <thread>
 
 #include "camera_source.h"
-#include "core/frames/frame_registry.h"
+#include "core/daemon/views.h"
 #include "core/plugin_host.h"
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
@@ -60,21 +61,22 @@ struct Fixture {
   std::unique_ptr<crease::Keypoints> kp = std::make_unique<crease::Keypoints>();
   explicit Fixture(double rate_hz = 30.0) { host.add_loop({"vision", rate_hz, 0, -1}); }
   // Relative paths resolve against config/ (the file named here).
+  // `channel`: the global name of the plugin's `images` port (empty: the default, "images").
   void add(const std::string& name, const std::string& library, int order,
-           const std::string& yaml) {
+           const std::string& yaml, const std::string& channel = "") {
     crease::InstanceSpec s;
     s.name = name;
     s.library = library;
     s.loop = "vision";
     s.order = order;
     s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
+    if (!channel.empty()) s.ports["images"] = channel;
     host.add_instance(s);
   }
   void add_vision(const std::string& cameras_dir, const std::string& channel,
                   const std::string& more = "") {
     add("vision", "vision", 10,
-        "{cameras: '" + cameras_dir + "', channel: " + channel + ", layout: markers/layout.yaml" +
-            more + "}");
+        "{cameras: '" + cameras_dir + "', layout: markers/layout.yaml" + more + "}", channel);
   }
   const crease::Keypoints& read() {
     const auto* ch = host.ports().find_latest("keypoints");
@@ -114,11 +116,11 @@ struct Fixture {
 std::map<std::uint64_t, crease::Keypoints> replay_keypoints(const std::string& dir,
                                                             const std::string& channel) {
   Fixture fx(10.0);  // slow enough that the test sees every frame's key-points on the port
-  fx.add("cameras", "camera_replay", 5, "{replay_dir: '" + dir + "', channel: " + channel + "}");
+  fx.add("cameras", "camera_replay", 5, "{replay_dir: '" + dir + "'}", channel);
   fx.add_vision(dir, channel);
   fx.host.start();
   std::map<std::uint64_t, crease::Keypoints> out;
-  const auto ch = crease::frames::FrameRegistry::instance().find(channel);
+  const auto ch = fx.host.ports().find_frames(channel);
   REQUIRE(ch != nullptr);
   REQUIRE(fx.wait_for([&] {
     if (fx.read().count > 0) out.emplace(fx.kp->frame, *fx.kp);
@@ -137,10 +139,10 @@ TEST_CASE(
   fs::remove(dir + "/cam2/000002.png");
   fs::remove(dir + "/cam2/000003.png");
   Fixture fx;
-  fx.add("cameras", "camera_replay", 5, "{replay_dir: '" + dir + "', channel: gap}");
+  fx.add("cameras", "camera_replay", 5, "{replay_dir: '" + dir + "'}", "gap");
   fx.add_vision(dir, "gap");
-  // Both dlopen'd plugins opened the same channel, and this executable sees it too.
-  const auto ch = crease::frames::FrameRegistry::instance().find("gap");
+  // Both dlopen'd plugins bound the same channel, and the host lists it.
+  const auto ch = fx.host.ports().find_frames("gap");
   REQUIRE(ch != nullptr);
   CHECK(ch->writer_claimed());
   CHECK(ch->reader_claimed());
@@ -194,8 +196,8 @@ TEST_CASE("camera_sim -> vision with the shipped cameras and layout, recording w
   const auto rec = tmp("simrec");
   Fixture fx;
   fx.add("cameras", "camera_sim", 5,
-         "{occluders: 1, fold_start_s: 0, fold_duration_s: 1, channel: sim, record: '" +
-             rec.string() + "'}");
+         "{occluders: 1, fold_start_s: 0, fold_duration_s: 1, record: '" + rec.string() + "'}",
+         "sim");
   fx.add_vision("cameras", "sim", ", camera_threads: 3");  // cameras on threads of ours
   fx.host.start();
   REQUIRE(fx.wait_for([&] { return fx.read().frame >= 2; }));
@@ -239,7 +241,7 @@ TEST_CASE("camera_v4l2 on image sequences and a missing /dev/video: the others g
   {
     Fixture fx;
     fx.add("cameras", "camera_v4l2", 5,
-           "{cameras: '" + (dir / "cams").string() + "', devices: " + devices + ", channel: v4l2}");
+           "{cameras: '" + (dir / "cams").string() + "', devices: " + devices + "}", "v4l2");
     fx.add_vision((dir / "cams").string(), "v4l2");
     fx.host.start();
     REQUIRE(fx.wait_for([&] { return fx.read().count > 0; }));
@@ -257,7 +259,8 @@ TEST_CASE("camera_v4l2 on image sequences and a missing /dev/video: the others g
   Fixture none;
   none.add("cameras", "camera_v4l2", 5,
            "{cameras: '" + (dir / "cams").string() +
-               "', devices: [/dev/video97, /dev/video98, /dev/video99], channel: v4l2}");
+               "', devices: [/dev/video97, /dev/video98, /dev/video99]}",
+           "v4l2");
   none.add_vision((dir / "cams").string(), "v4l2");
   none.host.start();
   REQUIRE(none.wait_for([&] {
@@ -271,10 +274,10 @@ TEST_CASE("camera_v4l2 on image sequences and a missing /dev/video: the others g
 
 TEST_CASE("hot swaps of camera_sim and vision: the new instances take over the channel's ends") {
   Fixture fx;
-  fx.add("cameras", "camera_sim", 5, "{channel: swap}");
+  fx.add("cameras", "camera_sim", 5, "{}", "swap");
   fx.add_vision("cameras", "swap");
   fx.host.start();
-  const auto ch = crease::frames::FrameRegistry::instance().find("swap");
+  const auto ch = fx.host.ports().find_frames("swap");
   REQUIRE(ch != nullptr);
   const auto* kp_port = fx.host.ports().find_latest("keypoints");
   REQUIRE(kp_port != nullptr);
@@ -296,5 +299,30 @@ TEST_CASE("hot swaps of camera_sim and vision: the new instances take over the c
   CHECK(fx.state("cameras") == crease::RunState::active);
   CHECK(fx.state("vision") == crease::RunState::active);
   CHECK(fx.host.fault_count() == 0);
+  fx.host.stop();
+}
+
+TEST_CASE("the frame channel between camera_sim and vision is listed with the ports") {
+  Fixture fx;
+  fx.add("cameras", "camera_sim", 5, "{}");  // default names: images (frames), frames (latest)
+  fx.add_vision("cameras", "");
+  fx.host.start();
+  REQUIRE(fx.wait_for([&] { return fx.read().frame >= 2; }));
+  // What `creasectl ports` shows (the daemon's `ports` command answers with this view).
+  const nlohmann::json ports = crease::daemon::ports_view(fx.host.ports());
+  const nlohmann::json* images = nullptr;
+  for (const auto& p : ports)
+    if (p["name"] == "images") images = &p;
+  REQUIRE(images != nullptr);
+  CHECK((*images)["kind"] == "frames");
+  CHECK((*images)["type"] == "crease.FrameSet");
+  CHECK((*images)["writer"] == "cameras");
+  CHECK((*images)["readers"] == nlohmann::json::array({"vision"}));
+  CHECK((*images)["cameras"].size() == 5);
+  CHECK((*images)["cameras"][0] == "cam0 1280x960");
+  CHECK((*images)["size"] == 5 * 1280 * 960);
+  CHECK((*images)["published"].get<std::uint64_t>() >= 3);
+  CHECK((*images)["consumed"].get<std::uint64_t>() >= 3);
+  CHECK(std::string(fx.frames().channel) == "images");
   fx.host.stop();
 }
