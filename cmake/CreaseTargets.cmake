@@ -50,6 +50,16 @@ endfunction()
 
 # Targets `tests-unit`, `tests-concurrency`, ... build just the executables of one label,
 # so the sanitizer builds compile only what they run. `crease_all_plugins` builds every plugin.
+# crease_compile_fail_test(NAME SOURCE file EXPECT regex)
+# A file that must not compile (a static_assert's test): passes when the compiler's output
+# matches EXPECT. Label unit; nothing to build.
+function(crease_compile_fail_test name)
+  cmake_parse_arguments(T "" "SOURCE;EXPECT" "" ${ARGN})
+  add_test(NAME ${name} COMMAND ${CMAKE_CXX_COMPILER} -std=c++20 -fsyntax-only -I${CMAKE_SOURCE_DIR}
+           ${CMAKE_CURRENT_SOURCE_DIR}/${T_SOURCE})
+  set_tests_properties(${name} PROPERTIES LABELS unit PASS_REGULAR_EXPRESSION "${T_EXPECT}")
+endfunction()
+
 function(crease_finish_test_targets)
   get_property(plugins GLOBAL PROPERTY CREASE_ALL_PLUGINS)
   add_custom_target(crease_all_plugins)

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "core/port_types/hand.h"  // DeviceHealth
+#include "core/port_types/payload_layout.h"
 
 namespace crease {
 
@@ -52,5 +53,8 @@ struct ArmState {
     return true;
   }
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(ArmCommand, 72, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(ArmState, 96, 8);
 
 }  // namespace crease

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "core/port_types/payload_layout.h"
+
 namespace crease {
 
 struct BridgeTopicStats {
@@ -38,5 +40,8 @@ struct BridgeStats {
   std::uint32_t stale = 0;  // subscribed topics stale now
   BridgeTopicStats topics[kCapacity];
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(BridgeTopicStats, 192, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(BridgeStats, 3080, 8);
 
 }  // namespace crease

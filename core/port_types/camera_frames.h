@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "core/port_types/payload_layout.h"
+
 namespace crease {
 
 struct CameraFrames {
@@ -21,5 +23,7 @@ struct CameraFrames {
   std::uint32_t ended = 0;       // 1: the source has no more frames (a replay's end)
   std::uint32_t reserved = 0;
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(CameraFrames, 88, 8);
 
 }  // namespace crease

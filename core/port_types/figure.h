@@ -5,7 +5,8 @@
 
 #include <cmath>
 #include <cstdint>
-#include <type_traits>
+
+#include "core/port_types/payload_layout.h"
 
 namespace crease {
 
@@ -24,7 +25,6 @@ struct Figure {
   [[nodiscard]] bool all_finite() const { return std::isfinite(sum) && std::isfinite(last) && std::isfinite(max); }
   [[nodiscard]] double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }
 };
-static_assert(std::is_trivially_copyable_v<Figure> && std::is_standard_layout_v<Figure>);
-static_assert(sizeof(Figure) == 120, "Figure's layout is part of the port contract");
+CREASE_PORT_PAYLOAD_LAYOUT(Figure, 120, 8);
 
 }  // namespace crease

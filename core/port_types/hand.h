@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/port_types/payload_layout.h"
+
 namespace crease {
 
 // Health of a device link as a driver reports it.
@@ -59,5 +61,8 @@ struct HandState {
     return true;
   }
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(HandCommand, 176, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(HandState, 144, 8);
 
 }  // namespace crease

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/port_types/payload_layout.h"
+
 namespace crease {
 
 struct Keypoint {
@@ -42,5 +44,8 @@ struct Keypoints {
     return true;
   }
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(Keypoint, 32, 4);
+CREASE_PORT_PAYLOAD_LAYOUT(Keypoints, 16408, 8);
 
 }  // namespace crease

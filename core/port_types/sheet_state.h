@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/port_types/payload_layout.h"
+
 namespace crease {
 
 struct SheetState {
@@ -89,5 +91,12 @@ struct SheetResetEvent {
   static constexpr std::uint32_t kPortVersion = 1;
   std::int64_t timestamp_ns = 0;
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(SheetState, 164528, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(TargetPoints::Point, 20, 4);
+CREASE_PORT_PAYLOAD_LAYOUT(TargetPoints, 20496, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(SheetCreaseEvent, 32, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(SheetMemorizeEvent, 32, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(SheetResetEvent, 8, 8);
 
 }  // namespace crease

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "core/port_types/hand.h"  // DeviceHealth
+#include "core/port_types/payload_layout.h"
 
 namespace crease {
 
@@ -31,5 +32,7 @@ struct Tactile {
     return true;
   }
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(Tactile, 712, 8);
 
 }  // namespace crease
