@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "core/errors.h"
+#include "core/assert.h"
 #include "core/plugin.h"
 
 namespace crease {
@@ -118,6 +118,7 @@ void PluginInstance::apply_param_changes_rt() noexcept {
   ParamChange c;
   auto& ts = binder_.tunables();
   while (param_changes_.try_pop(&c)) {
+    CREASE_DEBUG_ASSERT(c.index < ts.size());  // set_param() queues indices into ts only
     if (c.index < ts.size()) *ts[c.index].target = c.value;
   }
 }

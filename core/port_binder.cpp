@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "core/errors.h"
+#include "core/assert.h"
 
 namespace crease {
 
@@ -49,9 +49,11 @@ std::shared_ptr<frames::FrameChannel> PortBinder::frames_input(std::string_view 
 
 void PortBinder::tunable(std::string_view key, double* value, double lo, double hi) {
   const std::string k(key);
-  if (value == nullptr || !(lo <= hi)) throw ConfigError("instance '" + instance_ + "': tunable '" + k + "' needs a target and lo <= hi");
+  // What a plugin library declares is input to the host: refused, never a crash of creased.
+  require_input(value != nullptr && lo <= hi,
+                "instance '" + instance_ + "': tunable '" + k + "' needs a target and lo <= hi");
   for (const Tunable& t : tunables_) {
-    if (t.key == k) throw ConfigError("instance '" + instance_ + "': tunable '" + k + "' declared twice");
+    require_input(t.key != k, "instance '" + instance_ + "': tunable '" + k + "' declared twice");
   }
   tunables_.push_back(Tunable{k, value, lo, hi, *value});
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/assert.h"
 #include "core/errors.h"
 
 namespace crease {
@@ -111,6 +112,7 @@ PortRegistry::Port& PortRegistry::bind_frames(const std::string& port, const std
       n.info.cameras.push_back(c.name + " " + std::to_string(c.width) + "x" + std::to_string(c.height));
     }
   });
+  CREASE_DEMAND(p.frames != nullptr, "a port of kind frames always has its channel");
   const auto& have = p.frames->cameras();
   const std::string head = "port '" + port + "': instance '" + instance + "' " + role_of(writer) + " ";
   if (have.size() != cameras.size()) {

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.h"
+#include "core/assert.h"
 
 namespace crease::frames {
 
@@ -44,8 +44,12 @@ class FrameSet {
   std::int64_t stamp_ns = 0;     // CLOCK_MONOTONIC capture time
   std::uint32_t valid_mask = 0;  // bit k: camera k delivered an image in this set
 
-  [[nodiscard]] std::uint8_t* pixels(std::size_t camera) noexcept { return images_[camera].get(); }
+  [[nodiscard]] std::uint8_t* pixels(std::size_t camera) noexcept {
+    CREASE_DEBUG_ASSERT(camera < images_.size());
+    return images_[camera].get();
+  }
   [[nodiscard]] const std::uint8_t* pixels(std::size_t camera) const noexcept {
+    CREASE_DEBUG_ASSERT(camera < images_.size());
     return images_[camera].get();
   }
   [[nodiscard]] bool valid(std::size_t camera) const noexcept {

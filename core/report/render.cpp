@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <stdexcept>
 
+#include "core/errors.h"
 #include "core/report/report_json.h"
 
 namespace crease::report {
@@ -206,14 +206,14 @@ std::vector<std::string> write_report_files(const TimingReport& report, const st
                                             const std::string& basename) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("report folder " + dir + ": " + ec.message());
+  if (ec) throw Error("report folder " + dir + ": " + ec.message());
   std::vector<std::string> paths;
   for (Format f : {Format::text, Format::json, Format::html}) {
     const std::string path = dir + "/" + basename + "." + file_extension(f);
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out << render(report, f);
     out.close();
-    if (!out) throw std::runtime_error("report " + path + ": cannot write");
+    if (!out) throw Error("report " + path + ": cannot write");
     paths.push_back(path);
   }
   return paths;

@@ -28,7 +28,7 @@ enum class Format { text, json, html };
 [[nodiscard]] std::string render(const TimingReport& report, Format format);
 
 // Writes DIR/BASENAME.{txt,json,html} (DIR created when missing) and returns the paths.
-// @throws std::runtime_error naming the file that could not be written.
+// @throws crease::Error naming the file that could not be written.
 std::vector<std::string> write_report_files(const TimingReport& report, const std::string& dir,
                                             const std::string& basename = "crease-report");
 

@@ -3,7 +3,8 @@
 #include <ode/ode.h>
 
 #include <mutex>
-#include <stdexcept>
+
+#include "core/assert.h"
 
 namespace crease::sheet {
 namespace {
@@ -29,7 +30,7 @@ CollisionWorld::~CollisionWorld() {
 int CollisionWorld::add_geom(dxGeom* g) {
   if (static_cast<int>(geoms_.size()) >= kMaxShapes) {
     dGeomDestroy(g);
-    throw std::invalid_argument("sheet_model: collision shapes: more than 64");
+    throw crease::ConfigError("sheet_model: collision shapes: more than 64");
   }
   geoms_.push_back(g);
   ++version_;
@@ -41,21 +42,21 @@ int CollisionWorld::add_table(double height_mm) {
 }
 
 int CollisionWorld::add_box(Vec3 s, Vec3 c) {
-  if (!(s.x > 0 && s.y > 0 && s.z > 0)) throw std::invalid_argument("sheet_model: box size_mm: must be > 0");
+  crease::require_input(s.x > 0 && s.y > 0 && s.z > 0, "sheet_model: box size_mm: must be > 0");
   dxGeom* g = dCreateBox(nullptr, s.x, s.y, s.z);
   dGeomSetPosition(g, c.x, c.y, c.z);
   return add_geom(g);
 }
 
 int CollisionWorld::add_sphere(double r, Vec3 c) {
-  if (!(r > 0)) throw std::invalid_argument("sheet_model: sphere radius_mm: must be > 0");
+  crease::require_input(r > 0, "sheet_model: sphere radius_mm: must be > 0");
   dxGeom* g = dCreateSphere(nullptr, r);
   dGeomSetPosition(g, c.x, c.y, c.z);
   return add_geom(g);
 }
 
 int CollisionWorld::add_capsule(double r, double len, Vec3 c) {
-  if (!(r > 0 && len >= 0)) throw std::invalid_argument("sheet_model: capsule radius_mm/length_mm: must be > 0");
+  crease::require_input(r > 0 && len >= 0, "sheet_model: capsule radius_mm/length_mm: must be > 0");
   dxGeom* g = dCreateCapsule(nullptr, r, len);
   dGeomSetPosition(g, c.x, c.y, c.z);
   return add_geom(g);

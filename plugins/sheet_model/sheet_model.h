@@ -49,7 +49,7 @@ class SheetModel {
   static constexpr int kMaxTargets = 4096;
   static constexpr int kMaxKeypoints = kMaxTargets;  // either coupling takes as many observations
 
-  explicit SheetModel(const SheetParams& params);  // throws std::invalid_argument
+  explicit SheetModel(const SheetParams& params);  // throws crease::ConfigError
   virtual ~SheetModel() = default;
   SheetModel(const SheetModel&) = delete;
   SheetModel& operator=(const SheetModel&) = delete;

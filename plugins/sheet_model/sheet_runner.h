@@ -25,7 +25,7 @@ class SheetRunner {
   static constexpr int kMarkerIds = 1024;  // key-point id = marker_id * 5 + corner
 
   // With table_height_mm finite, the table plane z = table_height_mm is a collision shape.
-  explicit SheetRunner(const SheetParams& params, double table_height_mm = 0.0);  // throws std::invalid_argument
+  explicit SheetRunner(const SheetParams& params, double table_height_mm = 0.0);  // throws crease::ConfigError
   // Runs a given backend (tests inject faulty ones; the ODE backend).
   explicit SheetRunner(std::unique_ptr<SheetModel> model, double table_height_mm = 0.0);
 

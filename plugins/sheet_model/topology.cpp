@@ -1,14 +1,16 @@
 #include "topology.h"
 
 #include <cstdlib>
-#include <stdexcept>
 #include <string>
+
+#include "core/assert.h"
 
 namespace crease::sheet {
 namespace {
 
+// Parameters come from a plugin's configuration (or a test's): bad input, ConfigError.
 void require(bool ok, const char* key, const char* why) {
-  if (!ok) throw std::invalid_argument(std::string("sheet_model: ") + key + ": " + why);
+  if (!ok) throw crease::ConfigError(std::string("sheet_model: ") + key + ": " + why);
 }
 
 }  // namespace

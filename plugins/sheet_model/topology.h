@@ -34,7 +34,7 @@ struct Topology {
   [[nodiscard]] int triangle_count() const { return static_cast<int>(tri.size() / 3); }
 };
 
-// Builds the grid and links. Throws std::invalid_argument naming the bad parameter.
+// Builds the grid and links. Throws crease::ConfigError naming the bad parameter.
 [[nodiscard]] Topology build_topology(const GridParams& grid, const TopologyParams& topo);
 
 }  // namespace crease::sheet

@@ -3,7 +3,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <stdexcept>
+
+#include "core/errors.h"
 
 namespace crease::sheet_score {
 
@@ -13,7 +14,7 @@ StateRecorder::StateRecorder(const std::string& path, std::int64_t start_ns, std
       queue_(sizeof(Frame), queue_frames),
       staging_(std::make_unique<Frame>()),
       writing_(std::make_unique<Frame>()) {
-  if (!out_) throw std::runtime_error("cannot write '" + path + "'");
+  if (!out_) throw crease::Error("cannot write '" + path + "'");
   thread_ = std::thread([this] { run(); });
 }
 

@@ -20,7 +20,7 @@ namespace crease::sheet_score {
 
 class StateRecorder {
  public:
-  // Opens (truncates) path and starts the writer thread. Throws std::runtime_error when the
+  // Opens (truncates) path and starts the writer thread. Throws crease::Error when the
   // file cannot be written. start_ns: the recording's time origin (CLOCK_MONOTONIC).
   StateRecorder(const std::string& path, std::int64_t start_ns, std::size_t queue_frames = 32);
   ~StateRecorder();  // stop()

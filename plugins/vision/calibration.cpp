@@ -1,17 +1,15 @@
 #include "calibration.h"
 
-#include <stdexcept>
-
 #include <opencv2/calib3d.hpp>
 
+#include "core/assert.h"
 #include "marker_layout.h"
 
 namespace crease::vision {
 
 cv::Ptr<cv::aruco::CharucoBoard> make_charuco(const CharucoSpec& s) {
-  if (s.squares_x < 3 || s.squares_y < 3) throw std::invalid_argument("ChArUco board needs at least 3x3 squares");
-  if (!(s.marker_mm > 0 && s.marker_mm < s.square_mm))
-    throw std::invalid_argument("ChArUco marker must be smaller than its square");
+  crease::require_input(s.squares_x >= 3 && s.squares_y >= 3, "ChArUco board needs at least 3x3 squares");
+  crease::require_input(s.marker_mm > 0 && s.marker_mm < s.square_mm, "ChArUco marker must be smaller than its square");
   return cv::aruco::CharucoBoard::create(s.squares_x, s.squares_y, static_cast<float>(s.square_mm),
                                          static_cast<float>(s.marker_mm), dictionary_by_name(s.dictionary));
 }
@@ -39,8 +37,8 @@ CharucoView detect_charuco(const cv::Mat& gray, const CharucoSpec& s, const Came
 }
 
 IntrinsicsResult calibrate_intrinsics(const std::vector<cv::Mat>& images, const CharucoSpec& s, int dist_count) {
-  if (dist_count != 4 && dist_count != 5 && dist_count != 8)
-    throw std::invalid_argument("distortion model must have 4, 5 or 8 coefficients");
+  crease::require_input(dist_count == 4 || dist_count == 5 || dist_count == 8,
+                        "distortion model must have 4, 5 or 8 coefficients");
   const auto board = make_charuco(s);
   std::vector<std::vector<cv::Point2f>> corners;
   std::vector<std::vector<int>> ids;
@@ -48,15 +46,14 @@ IntrinsicsResult calibrate_intrinsics(const std::vector<cv::Mat>& images, const 
   for (const cv::Mat& img : images) {
     if (img.empty()) continue;
     if (size.area() == 0) size = img.size();
-    if (img.size() != size) throw std::runtime_error("calibration images differ in size");
+    crease::require_input(img.size() == size, "calibration images differ in size");
     CharucoView v = detect_charuco(img, s);
     if (v.ids.size() < 8) continue;
     corners.push_back(std::move(v.corners));
     ids.push_back(std::move(v.ids));
   }
-  if (corners.size() < 4)
-    throw std::runtime_error("only " + std::to_string(corners.size()) +
-                             " images show the ChArUco board (need 4 with >= 8 corners)");
+  crease::require_input(corners.size() >= 4, "only " + std::to_string(corners.size()) +
+                                                 " images show the ChArUco board (need 4 with >= 8 corners)");
   cv::Mat K, dist;
   int flags = 0;
   if (dist_count == 8) flags |= cv::CALIB_RATIONAL_MODEL;

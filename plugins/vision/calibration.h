@@ -38,7 +38,8 @@ struct IntrinsicsResult {
   double rms_px = 0;
   int views_used = 0;
 };
-// Throws std::runtime_error when fewer than 4 images show at least 8 board corners.
+// Throws crease::ConfigError when fewer than 4 images show at least 8 board corners, the
+// images differ in size or dist_count is not 4, 5 or 8.
 IntrinsicsResult calibrate_intrinsics(const std::vector<cv::Mat>& images, const CharucoSpec& spec,
                                       int dist_count = 5);
 

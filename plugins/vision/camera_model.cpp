@@ -2,9 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <stdexcept>
 
 #include <opencv2/core/persistence.hpp>
+
+#include "core/assert.h"
 
 namespace crease::vision {
 
@@ -92,8 +93,9 @@ std::vector<Camera> default_rig() {
 
 namespace {
 
+// cv::FileStorage keeps no line numbers: the file and the key.
 [[noreturn]] void fail(const std::string& path, const std::string& key, const std::string& why) {
-  throw std::runtime_error(path + ": key '" + key + "': " + why);
+  throw crease::ConfigError(path + ": key '" + key + "': " + why);
 }
 
 cv::Mat read_matrix(const cv::FileStorage& fs, const std::string& path, const char* key, int rows,
@@ -130,9 +132,9 @@ int read_int(const cv::FileStorage& fs, const std::string& path, const char* key
 Camera load_camera(const std::string& path) {
   cv::FileStorage fs;
   try {
-    if (!fs.open(path, cv::FileStorage::READ)) throw std::runtime_error(path + ": cannot read calibration file");
+    if (!fs.open(path, cv::FileStorage::READ)) throw crease::ConfigError(path + ": cannot read calibration file");
   } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": cannot parse calibration file: " + e.err);
+    throw crease::ConfigError(path + ": cannot parse calibration file: " + e.err);
   }
   Camera c;
   c.name = std::filesystem::path(path).stem().string();
@@ -164,7 +166,7 @@ Camera load_camera(const std::string& path) {
 
 void save_camera(const Camera& c, const std::string& path) {
   cv::FileStorage fs;
-  if (!fs.open(path, cv::FileStorage::WRITE)) throw std::runtime_error(path + ": cannot open for writing");
+  if (!fs.open(path, cv::FileStorage::WRITE)) throw crease::Error(path + ": cannot open for writing");
   fs.writeComment("Crease camera calibration: pinhole + OpenCV distortion; pose maps world to camera "
                   "(x_cam = rotation * x_world + translation), millimetres.");
   fs << "image_width" << c.width << "image_height" << c.height;
@@ -181,7 +183,7 @@ std::vector<Camera> load_camera_dir(const std::string& dir) {
     if (!std::filesystem::exists(p)) break;
     cams.push_back(load_camera(p));
   }
-  if (cams.empty()) throw std::runtime_error(dir + ": no camera files cam0.yaml, cam1.yaml, ...");
+  crease::require_input(!cams.empty(), dir + ": no camera files cam0.yaml, cam1.yaml, ...");
   return cams;
 }
 

@@ -41,13 +41,14 @@ Camera look_at_camera(const std::string& name, int width, int height, double foc
 // barrel distortion. Used for config/cameras/ and the synthetic tests.
 std::vector<Camera> default_rig();
 
-// Throws std::runtime_error "<path>: key '<key>': <reason>" on an unreadable file, a missing
+// Throws crease::ConfigError "<path>: key '<key>': <reason>" on an unreadable file, a missing
 // key, a matrix of the wrong size, a non-positive focal length or a rotation that is not one.
 Camera load_camera(const std::string& path);
+// Throws crease::Error naming the file when it cannot be written.
 void save_camera(const Camera& cam, const std::string& path);
 
-// Loads DIR/cam0.yaml, DIR/cam1.yaml, ... (consecutive from 0) or the files listed; throws if
-// none is found.
+// Loads DIR/cam0.yaml, DIR/cam1.yaml, ... (consecutive from 0) or the files listed; throws
+// crease::ConfigError if none is found.
 std::vector<Camera> load_camera_dir(const std::string& dir);
 
 }  // namespace crease::vision

@@ -7,10 +7,11 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "core/assert.h"
 
 namespace crease::vision {
 
@@ -52,7 +53,7 @@ ReplaySource::ReplaySource(const std::string& dir) : dir_(dir) {
   cameras_ = load_camera_dir(dir);
   const std::string csv = dir + "/timestamps.csv";
   std::ifstream in(csv);
-  if (!in) throw std::runtime_error(csv + ": cannot read");
+  crease::require_input(static_cast<bool>(in), csv + ": cannot read");
   std::string line;
   int lineno = 0;
   while (std::getline(in, line)) {
@@ -63,8 +64,8 @@ ReplaySource::ReplaySource(const std::string& dir) : dir_(dir) {
     long long t = 0;
     char comma = 0;
     std::istringstream ls(line);
-    if (!(ls >> f >> comma >> t) || comma != ',')
-      throw std::runtime_error(csv + ": line " + std::to_string(lineno) + ": expected 'frame,timestamp_ns'");
+    crease::require_input(static_cast<bool>(ls >> f >> comma >> t) && comma == ',',
+                          csv + ": line " + std::to_string(lineno) + ": expected 'frame,timestamp_ns'");
     stamps_.emplace_back(f, static_cast<std::int64_t>(t));
   }
 }
@@ -97,16 +98,15 @@ std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(s * 1e9)
 V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
                        ReconnectPolicy policy)
     : cameras_(std::move(cameras)), policy_(policy) {
-  if (devices.size() != cameras_.size())
-    throw std::invalid_argument("camera_v4l2: " + std::to_string(devices.size()) + " devices for " +
-                                std::to_string(cameras_.size()) + " calibrations");
-  if (devices.size() > kMaxCameras)
-    throw std::invalid_argument("camera_v4l2: " + std::to_string(devices.size()) +
-                                " devices, at most " + std::to_string(kMaxCameras));
-  if (!(policy_.initial_s > 0.0) || !(policy_.max_s >= policy_.initial_s))
-    throw std::invalid_argument("camera_v4l2: reconnect times must satisfy 0 < initial (" +
-                                std::to_string(policy_.initial_s) + " s) <= max (" +
-                                std::to_string(policy_.max_s) + " s)");
+  crease::require_input(devices.size() == cameras_.size(),
+                        "camera_v4l2: " + std::to_string(devices.size()) + " devices for " +
+                            std::to_string(cameras_.size()) + " calibrations");
+  crease::require_input(devices.size() <= kMaxCameras, "camera_v4l2: " + std::to_string(devices.size()) +
+                                                           " devices, at most " + std::to_string(kMaxCameras));
+  crease::require_input(policy_.initial_s > 0.0 && policy_.max_s >= policy_.initial_s,
+                        "camera_v4l2: reconnect times must satisfy 0 < initial (" +
+                            std::to_string(policy_.initial_s) + " s) <= max (" + std::to_string(policy_.max_s) +
+                            " s)");
   reconnects_ = std::make_unique<std::atomic<std::uint64_t>[]>(devices.size());
   devices_.resize(devices.size());
   const std::int64_t now = monotonic_ns();
@@ -210,7 +210,7 @@ Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras) :
   }
   const std::string csv = dir + "/timestamps.csv";
   stamps_ = std::fopen(csv.c_str(), "w");
-  if (stamps_ == nullptr) throw std::runtime_error(csv + ": cannot open for writing");
+  if (stamps_ == nullptr) throw crease::Error(csv + ": cannot open for writing");
   std::fprintf(stamps_, "frame,timestamp_ns\n");
 }
 
@@ -222,7 +222,7 @@ void Recorder::write(const Frame& frame) {
   for (std::size_t k = 0; k < ncam_ && k < frame.images.size(); ++k) {
     if (frame.images[k].empty()) continue;
     const std::string p = frame_path(dir_, k, frame.index);
-    if (!cv::imwrite(p, frame.images[k])) throw std::runtime_error(p + ": write failed");
+    if (!cv::imwrite(p, frame.images[k])) throw crease::Error(p + ": write failed");
   }
   std::fprintf(stamps_, "%" PRIu64 ",%" PRId64 "\n", frame.index, frame.timestamp_ns);
   std::fflush(stamps_);

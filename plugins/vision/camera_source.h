@@ -58,7 +58,7 @@ class SimSource final : public CameraSource {
   std::uint64_t next_ = 0;
 };
 
-// Reads a recorded directory. Throws std::runtime_error naming the file on a missing or bad
+// Reads a recorded directory. Throws crease::ConfigError naming the file on a missing or bad
 // calibration or timestamps.csv; a missing image is an empty image (that camera stopped).
 class ReplaySource final : public CameraSource {
  public:
@@ -92,7 +92,7 @@ struct ReconnectPolicy {
 class V4l2Source final : public CameraSource {
  public:
   static constexpr std::size_t kMaxCameras = 32;  // one bit each in dark_mask()
-  // Throws std::invalid_argument when devices and calibrations differ in number, there are more
+  // Throws crease::ConfigError when devices and calibrations differ in number, there are more
   // than kMaxCameras, or the policy is not 0 < initial_s <= max_s.
   V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
              ReconnectPolicy policy = {});

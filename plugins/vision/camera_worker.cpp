@@ -1,7 +1,8 @@
 #include "camera_worker.h"
 
 #include <cstring>
-#include <stdexcept>
+
+#include "core/assert.h"
 
 namespace crease::vision {
 
@@ -15,9 +16,9 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
                            std::shared_ptr<crease::frames::FrameChannel> channel,
                            const std::string& record_dir)
     : source_(std::move(source)), channel_(std::move(channel)) {
-  if (channel_->cameras() != channel_specs(source_->cameras()))
-    throw std::invalid_argument("frame channel '" + channel_->name() +
-                                "' does not have this source's cameras");
+  // The plugin bound the channel with these cameras (images_port.h): the registry checked them.
+  CREASE_DEMAND(channel_->cameras() == channel_specs(source_->cameras()),
+                "the frame channel does not have this source's cameras");
   if (!record_dir.empty()) recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras());
   writer_ = channel_->try_claim_writer();  // now if free, so the first request need not wait
   thread_ = std::thread([this] { run(); });

@@ -24,7 +24,7 @@ namespace crease::vision {
 
 class CameraWorker {
  public:
-  // Takes the source; `channel` must have the source's cameras (channel_specs). `record_dir`
+  // Takes the source; `channel` must have the source's cameras (channel_specs; CREASE_DEMAND). `record_dir`
   // non-empty writes every grabbed frame there in the replay layout. The writer end of the
   // channel is claimed on the worker thread before the first grab (waiting, off RT, for a
   // previous writer to release it: a hot swap).

@@ -1,8 +1,9 @@
 #include "keypoint_pipeline.h"
 
 #include <cmath>
-#include <stdexcept>
 #include <string>
+
+#include "core/assert.h"
 
 namespace crease::vision {
 
@@ -77,9 +78,8 @@ void build_keypoints(const std::vector<Camera>& cams, const MarkerLayout& layout
 KeypointPipeline::KeypointPipeline(std::vector<Camera> cams, MarkerLayout layout, DetectorConfig det,
                                    TriangulationConfig tri, int camera_threads)
     : cams_(std::move(cams)), layout_(std::move(layout)), tri_(tri) {
-  if (camera_threads < 0)
-    throw std::invalid_argument("camera_threads: expected 0 (OpenCV's pool) or >= 1, not " +
-                                std::to_string(camera_threads));
+  // The vision plugin reads camera_threads in [0, 64]: a negative count is a caller's bug.
+  CREASE_DEMAND(camera_threads >= 0, "camera_threads: expected 0 (OpenCV's pool) or >= 1");
   if (camera_threads >= 1) team_ = std::make_unique<TaskTeam>(camera_threads - 1);
   if (det.max_id < 0) det.max_id = layout_.max_id();
   det.dictionary = layout_.dictionary;

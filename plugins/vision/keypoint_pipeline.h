@@ -31,7 +31,7 @@ class KeypointPipeline {
  public:
   // camera_threads: 0 detects the cameras in parallel through cv::parallel_for_ (OpenCV's
   // pool); N >= 1 on N threads of our own, the caller of process() and N-1 helpers (TaskTeam;
-  // 1: one camera after the other on the caller). Throws std::invalid_argument when negative.
+  // 1: one camera after the other on the caller). Negative: a caller's bug (CREASE_DEMAND).
   KeypointPipeline(std::vector<Camera> cams, MarkerLayout layout, DetectorConfig det,
                    TriangulationConfig tri, int camera_threads = 0);
 

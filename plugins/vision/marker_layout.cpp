@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <fstream>
-#include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
+
+#include "core/assert.h"
 
 namespace crease::vision {
 
@@ -25,7 +26,7 @@ cv::Size2d paper_size_mm(const std::string& paper) {
   if (paper == "a3") return {297.0, 420.0};
   if (paper == "a5") return {148.0, 210.0};
   if (paper == "letter") return {215.9, 279.4};
-  throw std::invalid_argument("unknown paper '" + paper + "' (a3, a4, a5, letter)");
+  throw crease::ConfigError("unknown paper '" + paper + "' (a3, a4, a5, letter)");
 }
 
 cv::Ptr<cv::aruco::Dictionary> dictionary_by_name(const std::string& name) {
@@ -38,29 +39,29 @@ cv::Ptr<cv::aruco::Dictionary> dictionary_by_name(const std::string& name) {
       {"aruco_original", DICT_ARUCO_ORIGINAL}};
   for (const auto& [n, d] : kNames)
     if (name == n) return getPredefinedDictionary(d);
-  throw std::invalid_argument("unknown dictionary '" + name +
-                              "' (apriltag36h11, apriltag36h10, apriltag25h9, apriltag16h5, "
-                              "4x4_50, 4x4_1000, 5x5_1000, 6x6_1000, aruco_original)");
+  throw crease::ConfigError("unknown dictionary '" + name +
+                            "' (apriltag36h11, apriltag36h10, apriltag25h9, apriltag16h5, "
+                            "4x4_50, 4x4_1000, 5x5_1000, 6x6_1000, aruco_original)");
 }
 
 MarkerLayout make_layout(const LayoutSpec& spec) {
   const cv::Size2d page = paper_size_mm(spec.paper);
   const auto dict = dictionary_by_name(spec.dictionary);
-  if (spec.cols < 1 || spec.rows < 1) throw std::invalid_argument("grid must be at least 1x1");
-  if (!(spec.marker_mm > 0)) throw std::invalid_argument("marker size must be positive");
+  crease::require_input(spec.cols >= 1 && spec.rows >= 1, "grid must be at least 1x1");
+  crease::require_input(spec.marker_mm > 0, "marker size must be positive");
   const double pitch_u = page.width / spec.cols;
   const double pitch_v = page.height / spec.rows;
   // A quiet zone of one cell on every side of every tag keeps its outer edge detectable.
   const double cell = spec.marker_mm / (dict->markerSize + 2);
-  if (spec.marker_mm + 2 * cell > std::min(pitch_u, pitch_v))
-    throw std::invalid_argument("markers of " + std::to_string(spec.marker_mm) + " mm do not fit a " +
-                                std::to_string(spec.cols) + "x" + std::to_string(spec.rows) +
-                                " grid on " + spec.paper + " with a one-cell quiet zone");
+  crease::require_input(spec.marker_mm + 2 * cell <= std::min(pitch_u, pitch_v),
+                        "markers of " + std::to_string(spec.marker_mm) + " mm do not fit a " +
+                            std::to_string(spec.cols) + "x" + std::to_string(spec.rows) + " grid on " +
+                            spec.paper + " with a one-cell quiet zone");
   const int faces = spec.double_sided ? 2 : 1;
   const int needed = spec.first_id + faces * spec.cols * spec.rows;
-  if (needed > dict->bytesList.rows)
-    throw std::invalid_argument("layout needs ids up to " + std::to_string(needed - 1) + " but " +
-                                spec.dictionary + " has " + std::to_string(dict->bytesList.rows));
+  crease::require_input(needed <= dict->bytesList.rows,
+                        "layout needs ids up to " + std::to_string(needed - 1) + " but " + spec.dictionary +
+                            " has " + std::to_string(dict->bytesList.rows));
 
   MarkerLayout L;
   L.dictionary = spec.dictionary;
@@ -124,24 +125,27 @@ void save_layout(const MarkerLayout& L, const std::string& path) {
   }
   out << YAML::EndSeq << YAML::EndMap;
   std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  if (!f) throw crease::Error(path + ": cannot open for writing");
   f << out.c_str() << "\n";
-  if (!f) throw std::runtime_error(path + ": write failed");
+  if (!f) throw crease::Error(path + ": write failed");
 }
 
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& key, const std::string& why) {
-  throw std::runtime_error(path + ": key '" + key + "': " + why);
+// "PATH:LINE:COLUMN: KEY: why", the place of `at` (the value, or the map a key is missing from).
+[[noreturn]] void fail(const std::string& path, const YAML::Node& at, const std::string& key,
+                       const std::string& why) {
+  const YAML::Mark m = at.IsDefined() ? at.Mark() : YAML::Mark::null_mark();
+  throw crease::ConfigError(crease::SourceLoc{path, m.line + 1, m.column + 1}, key, why);
 }
 
 YAML::Node need(const YAML::Node& n, const char* key, const std::string& path, const std::string& ctx) {
-  if (!n[key]) fail(path, ctx + key, "missing");
+  if (!n[key]) fail(path, n, ctx + key, "missing");
   return n[key];
 }
 
 cv::Point2d point(const YAML::Node& n, const std::string& path, const std::string& key) {
-  if (!n.IsSequence() || n.size() != 2) fail(path, key, "expected [u, v]");
+  if (!n.IsSequence() || n.size() != 2) fail(path, n, key, "expected [u, v]");
   return {n[0].as<double>(), n[1].as<double>()};
 }
 
@@ -152,43 +156,45 @@ MarkerLayout load_layout(const std::string& path) {
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
-    throw std::runtime_error(path + ": cannot read layout file");
+    throw crease::ConfigError(path + ": cannot read layout file");
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw crease::ConfigError(path + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   MarkerLayout L;
   try {
-    L.dictionary = need(root, "dictionary", path, "").as<std::string>();
+    const YAML::Node dictionary = need(root, "dictionary", path, "");
+    L.dictionary = dictionary.as<std::string>();
     try {
       dictionary_by_name(L.dictionary);
-    } catch (const std::invalid_argument& e) {
-      fail(path, "dictionary", e.what());
+    } catch (const crease::ConfigError& e) {
+      fail(path, dictionary, "dictionary", e.what());
     }
     L.paper = root["paper"] ? root["paper"].as<std::string>() : std::string("custom");
     const auto size = need(root, "sheet_size_mm", path, "");
     const cv::Point2d s = point(size, path, "sheet_size_mm");
     L.sheet_w_mm = s.x;
     L.sheet_h_mm = s.y;
-    if (!(L.sheet_w_mm > 0 && L.sheet_h_mm > 0)) fail(path, "sheet_size_mm", "must be positive");
+    if (!(L.sheet_w_mm > 0 && L.sheet_h_mm > 0)) fail(path, size, "sheet_size_mm", "must be positive");
     L.marker_mm = need(root, "marker_mm", path, "").as<double>();
     const auto ms = need(root, "markers", path, "");
-    if (!ms.IsSequence()) fail(path, "markers", "expected a list");
+    if (!ms.IsSequence()) fail(path, ms, "markers", "expected a list");
     for (std::size_t i = 0; i < ms.size(); ++i) {
       const std::string ctx = "markers[" + std::to_string(i) + "].";
       MarkerPlacement m;
       m.id = need(ms[i], "id", path, ctx).as<int>();
-      const auto face = need(ms[i], "face", path, ctx).as<std::string>();
-      if (face != "front" && face != "back") fail(path, ctx + "face", "expected front or back");
+      const YAML::Node face_node = need(ms[i], "face", path, ctx);
+      const auto face = face_node.as<std::string>();
+      if (face != "front" && face != "back") fail(path, face_node, ctx + "face", "expected front or back");
       m.face = face == "front" ? Face::kFront : Face::kBack;
       m.centre_mm = point(need(ms[i], "centre", path, ctx), path, ctx + "centre");
       const auto cs = need(ms[i], "corners", path, ctx);
-      if (!cs.IsSequence() || cs.size() != 4) fail(path, ctx + "corners", "expected 4 corners");
+      if (!cs.IsSequence() || cs.size() != 4) fail(path, cs, ctx + "corners", "expected 4 corners");
       for (int k = 0; k < 4; ++k) m.corners_mm[k] = point(cs[k], path, ctx + "corners");
-      if (L.index_of(m.id) >= 0) fail(path, ctx + "id", "duplicate id " + std::to_string(m.id));
+      if (L.index_of(m.id) >= 0) fail(path, ms[i]["id"], ctx + "id", "duplicate id " + std::to_string(m.id));
       L.markers.push_back(m);
     }
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw crease::ConfigError(path + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   return L;
 }

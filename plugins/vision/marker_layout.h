@@ -47,18 +47,20 @@ struct MarkerLayout {
   [[nodiscard]] int max_id() const;
 };
 
-// Paper size in mm for a name ("a4", "letter", "a3"); throws std::invalid_argument.
+// Paper size in mm for a name ("a4", "letter", "a3"); throws crease::ConfigError.
 cv::Size2d paper_size_mm(const std::string& paper);
 // OpenCV predefined dictionary for a name ("apriltag36h11", "apriltag25h9", "4x4_50", ...);
-// throws std::invalid_argument naming the dictionary.
+// throws crease::ConfigError naming the dictionary.
 cv::Ptr<cv::aruco::Dictionary> dictionary_by_name(const std::string& name);
 
-// A regular grid of markers per face, centred on the page; throws on a grid that does not
-// fit the paper or needs more ids than the dictionary has.
+// A regular grid of markers per face, centred on the page; throws crease::ConfigError on a grid
+// that does not fit the paper or needs more ids than the dictionary has.
 MarkerLayout make_layout(const LayoutSpec& spec);
 
+// Throws crease::Error naming the file when it cannot be written.
 void save_layout(const MarkerLayout& layout, const std::string& path);
-// Throws std::runtime_error naming the file and the key on a missing or malformed entry.
+// Throws crease::ConfigError "FILE:LINE:COLUMN: KEY: reason" on a missing or malformed entry
+// ("FILE: cannot read layout file", "FILE: line N: ..." for an unreadable or non-YAML file).
 MarkerLayout load_layout(const std::string& path);
 
 }  // namespace crease::vision

@@ -5,8 +5,9 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
-#include <stdexcept>
 #include <vector>
+
+#include "core/assert.h"
 
 namespace crease::vision {
 
@@ -36,7 +37,7 @@ double overlap(double a0, double a1, double b0, double b1) {
 }  // namespace
 
 cv::Mat render_page(const MarkerLayout& L, Face face, double ppm) {
-  if (!(ppm > 0)) throw std::invalid_argument("render_page: px_per_mm must be positive");
+  crease::require_input(ppm > 0, "render_page: px_per_mm must be positive");  // crease-markers --dpi
   const auto dict = dictionary_by_name(L.dictionary);
   const int W = static_cast<int>(std::lround(L.sheet_w_mm * ppm));
   const int H = static_cast<int>(std::lround(L.sheet_h_mm * ppm));
@@ -151,9 +152,9 @@ void write_sheet_pdf(const MarkerLayout& L, const std::string& path) {
   pdf += "trailer\n<< /Size " + std::to_string(objs.size() + 1) + " /Root 1 0 R >>\nstartxref\n" +
          std::to_string(xref) + "\n%%EOF\n";
   std::ofstream f(path, std::ios::binary);
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  if (!f) throw crease::Error(path + ": cannot open for writing");
   f.write(pdf.data(), static_cast<std::streamsize>(pdf.size()));
-  if (!f) throw std::runtime_error(path + ": write failed");
+  if (!f) throw crease::Error(path + ": write failed");
 }
 
 }  // namespace crease::vision

@@ -19,7 +19,7 @@ cv::Mat render_page(const MarkerLayout& layout, Face face, double px_per_mm);
 cv::Mat face_texture(const MarkerLayout& layout, Face face, double px_per_mm);
 
 // Writes a vector PDF (one page per face, true scale at 100 %): each run of black cells is a
-// filled rectangle. Throws std::runtime_error naming the file on a write error.
+// filled rectangle. Throws crease::Error naming the file on a write error.
 void write_sheet_pdf(const MarkerLayout& layout, const std::string& path);
 
 }  // namespace crease::vision

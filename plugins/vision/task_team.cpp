@@ -1,11 +1,11 @@
 #include "task_team.h"
 
-#include <stdexcept>
+#include "core/assert.h"
 
 namespace crease::vision {
 
 TaskTeam::TaskTeam(int helpers) {
-  if (helpers < 0) throw std::invalid_argument("TaskTeam: negative number of helper threads");
+  CREASE_DEMAND(helpers >= 0, "TaskTeam: negative number of helper threads");
   errors_.resize(static_cast<std::size_t>(helpers));
   threads_.reserve(static_cast<std::size_t>(helpers));
   for (std::size_t i = 0; i < static_cast<std::size_t>(helpers); ++i)

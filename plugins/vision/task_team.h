@@ -15,7 +15,8 @@ namespace crease::vision {
 
 class TaskTeam {
  public:
-  // `helpers` threads besides the caller (0: run() does every task on the caller).
+  // `helpers` threads besides the caller (0: run() does every task on the caller); >= 0
+  // (CREASE_DEMAND).
   explicit TaskTeam(int helpers);
   ~TaskTeam();
   TaskTeam(const TaskTeam&) = delete;

@@ -1,6 +1,6 @@
 #include "vision_worker.h"
 
-#include <stdexcept>
+#include "core/assert.h"
 
 #include "camera_worker.h"
 
@@ -14,9 +14,8 @@ VisionWorker::VisionWorker(std::shared_ptr<crease::frames::FrameChannel> channel
       pipeline_(cameras, layout, det, tri, camera_threads),
       result_(std::make_unique<crease::Keypoints>()),
       images_(cameras.size()) {
-  if (channel_->cameras() != channel_specs(cameras))
-    throw std::invalid_argument("frame channel '" + channel_->name() +
-                                "' does not have these cameras");
+  // The plugin bound the channel with these cameras (images_port.h): the registry checked them.
+  CREASE_DEMAND(channel_->cameras() == channel_specs(cameras), "the frame channel does not have these cameras");
   reader_ = channel_->try_claim_reader();
   thread_ = std::thread([this] { run(); });
 }

@@ -23,7 +23,7 @@ namespace crease::vision {
 class VisionWorker {
  public:
   // `cameras` are the calibrations of the channel's cameras, in its order (names and sizes must
-  // match: std::invalid_argument otherwise). The reader end is claimed now if free, else on the
+  // match: a caller's promise, CREASE_DEMAND). The reader end is claimed now if free, else on the
   // worker thread as soon as the previous reader releases it (a hot swap). camera_threads:
   // KeypointPipeline's (0: cameras through cv::parallel_for_; N >= 1: on this worker and N-1
   // helper threads of ours).

@@ -39,3 +39,16 @@ TEST_CASE("CREASE_DEMAND aborts with the place and the reason") {
   CHECK(text.find("internal error at") != std::string::npos);
   CHECK(text.find("arithmetic is broken (1 + 1 == 3)") != std::string::npos);
 }
+
+TEST_CASE("require_input with a place throws the structured ConfigError") {
+  CHECK_NOTHROW(crease::require_input(true, crease::SourceLoc{"sim.yaml", 3, 1}, "loops", "fine"));
+  try {
+    crease::require_input(false, crease::SourceLoc{"sim.yaml", 3, 1}, "loops", "at least one loop");
+    FAIL("no throw");
+  } catch (const crease::ConfigError& e) {
+    CHECK(std::string(e.what()) == "sim.yaml:3:1: loops: at least one loop");
+    CHECK(e.loc().line == 3);
+    CHECK(e.key_path() == "loops");
+    CHECK(e.reason() == "at least one loop");
+  }
+}

@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <set>
-#include <stdexcept>
 #include <utility>
+
+#include "core/errors.h"
 
 using namespace crease::sheet;
 
@@ -52,5 +53,5 @@ TEST_CASE("bad parameters name the key") {
   GridParams g;
   g.nodes_u = 1;
   CHECK_THROWS_WITH_AS(build_topology(g, TopologyParams{}), doctest::Contains("grid.nodes_u"),
-                       std::invalid_argument);
+                       crease::ConfigError);
 }

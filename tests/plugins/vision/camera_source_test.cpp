@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/errors.h"
 #include "keypoint_pipeline.h"
 #include "vision_fixture.h"
 
@@ -92,8 +93,8 @@ TEST_CASE("a camera whose files stop leaves the others running; bad recordings n
   CHECK(k[1].count == 35 * 5);
 
   std::ofstream(dir + "/timestamps.csv") << "frame,timestamp_ns\n0;12\n";
-  CHECK_THROWS_WITH_AS(ReplaySource{dir}, doctest::Contains("timestamps.csv: line 2"), std::runtime_error);
-  CHECK_THROWS_WITH_AS(ReplaySource{tmp_dir("nothing")}, doctest::Contains("cam0.yaml"), std::runtime_error);
+  CHECK_THROWS_WITH_AS(ReplaySource{dir}, doctest::Contains("timestamps.csv: line 2"), crease::ConfigError);
+  CHECK_THROWS_WITH_AS(ReplaySource{tmp_dir("nothing")}, doctest::Contains("cam0.yaml"), crease::ConfigError);
 }
 
 namespace {
@@ -183,11 +184,11 @@ TEST_CASE("camera_v4l2 source: a device that stops is dark, retried, and back wh
 TEST_CASE("camera_v4l2 source: bad reconnect times and device counts are refused") {
   const std::vector<std::string> two{"/dev/video97", "/dev/video98"};
   CHECK_THROWS_WITH_AS(V4l2Source(tiny_rig(), two, {.initial_s = 0.0, .max_s = 1.0}),
-                       doctest::Contains("reconnect"), std::invalid_argument);
+                       doctest::Contains("reconnect"), crease::ConfigError);
   CHECK_THROWS_WITH_AS(V4l2Source(tiny_rig(), two, {.initial_s = 2.0, .max_s = 1.0}),
-                       doctest::Contains("reconnect"), std::invalid_argument);
+                       doctest::Contains("reconnect"), crease::ConfigError);
   CHECK_THROWS_WITH_AS(V4l2Source(tiny_rig(), {"/dev/video97"}), doctest::Contains("1 devices for 2"),
-                       std::invalid_argument);
+                       crease::ConfigError);
   V4l2Source none(tiny_rig(), two, kFastRetry);  // nothing opens: dark, never ends
   Frame f;
   CHECK(none.grab(f));

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "rt/alloc_guard.h"
+#include "support/abort_message.h"
 #include "vision_fixture.h"
 
 using namespace crease::vision;
@@ -144,11 +145,15 @@ TEST_CASE("a new worker waits for the old one's writer end (hot swap), then publ
   CHECK(p.frame == 0);     // the new source's first frame
 }
 
-TEST_CASE("a worker refuses a channel with other cameras") {
+TEST_CASE("a channel with other cameras than the source's is a bug: the worker aborts") {
+  // Plugins get the channel from the port registry, which checked the cameras (images_port.h).
   crease::vision::testing::Scene s;
   auto ch = std::make_shared<crease::frames::FrameChannel>(
       "camera_worker_test.other", std::vector<crease::frames::CameraSpec>{{"a", 320, 240}});
-  CHECK_THROWS_WITH_AS(
-      CameraWorker(std::make_unique<FlakySource>(renderer(s), s.flat(), 1), ch, ""),
-      doctest::Contains("'camera_worker_test.other'"), std::invalid_argument);
+  auto source = std::make_unique<FlakySource>(renderer(s), s.flat(), 1);  // here: the child only aborts
+  const std::string why =
+      crease::testing::abort_message([&] { CameraWorker w(std::move(source), ch, ""); });
+  CHECK(why.find("internal error at") != std::string::npos);
+  CHECK(why.find("the frame channel does not have this source's cameras") != std::string::npos);
+  CHECK_FALSE(ch->writer_claimed());
 }

@@ -7,6 +7,7 @@
 
 #include <doctest/doctest.h>
 
+#include "core/errors.h"
 #include "marker_sheet.h"
 
 using namespace crease::vision;
@@ -71,13 +72,19 @@ TEST_CASE("bad layouts are refused with the file and key") {
     std::ofstream(p) << "dictionary: apriltag36h11\nsheet_size_mm: [210, 297]\nmarker_mm: 28\nmarkers:\n"
                         "  - {id: 1, face: front, centre: [10, 10]}\n";
   }
-  CHECK_THROWS_WITH_AS(load_layout(p), doctest::Contains("markers[0].corners"), std::runtime_error);
+  // FILE:LINE:COLUMN: KEY: reason, the place of the map the key is missing from.
+  CHECK_THROWS_WITH_AS(load_layout(p), (p + ":5:5: markers[0].corners: missing").c_str(), crease::ConfigError);
   { std::ofstream(p) << "dictionary: nosuch\nsheet_size_mm: [210, 297]\nmarker_mm: 28\nmarkers: []\n"; }
-  CHECK_THROWS_WITH_AS(load_layout(p), doctest::Contains("'dictionary'"), std::runtime_error);
-  CHECK_THROWS_WITH_AS(load_layout(tmp_path("missing.yaml")), doctest::Contains("missing.yaml"), std::runtime_error);
+  CHECK_THROWS_WITH_AS(load_layout(p), doctest::Contains((p + ":1:13: dictionary: unknown dictionary 'nosuch'").c_str()),
+                       crease::ConfigError);
+  { std::ofstream(p) << "dictionary: apriltag36h11\nsheet_size_mm: [210, 297]\nmarker_mm: 28\nmarkers:\n"
+                        "  - {id: 1, face: top, centre: [10, 10], corners: [[0, 0], [1, 0], [1, 1], [0, 1]]}\n"; }
+  CHECK_THROWS_WITH_AS(load_layout(p), (p + ":5:19: markers[0].face: expected front or back").c_str(),
+                       crease::ConfigError);
+  CHECK_THROWS_WITH_AS(load_layout(tmp_path("missing.yaml")), doctest::Contains("missing.yaml"), crease::ConfigError);
   LayoutSpec big;
   big.marker_mm = 45;  // does not fit 5 columns on A4 with a quiet zone
-  CHECK_THROWS_AS(make_layout(big), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(make_layout(big), doctest::Contains("do not fit a 5x7 grid"), crease::ConfigError);
 }
 
 TEST_CASE("page raster: black cells where the layout says, white paper elsewhere") {

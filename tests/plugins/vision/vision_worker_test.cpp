@@ -13,6 +13,7 @@
 
 #include "camera_worker.h"
 #include "rt/alloc_guard.h"
+#include "support/abort_message.h"
 #include "vision_fixture.h"
 
 using namespace crease::vision;
@@ -83,14 +84,16 @@ TEST_CASE("each published set is detected once, without allocating on the RT sid
   }
 }
 
-TEST_CASE("calibrations that do not match the channel are refused; the reader end is released") {
+TEST_CASE("calibrations that do not match the channel are a bug; a worker releases its reader end") {
+  // Plugins get the channel from the port registry, which checked the cameras (images_port.h).
   crease::vision::testing::Scene s;
   auto ch = std::make_shared<crease::frames::FrameChannel>("vision_worker_test.b",
                                                            channel_specs(small_rig()));
   auto other = small_rig();
   other[1].width = 640;
-  CHECK_THROWS_WITH_AS(VisionWorker(ch, other, s.layout, DetectorConfig{}, TriangulationConfig{}),
-                       doctest::Contains("'vision_worker_test.b'"), std::invalid_argument);
+  const std::string why = crease::testing::abort_message(
+      [&] { VisionWorker w(ch, other, s.layout, DetectorConfig{}, TriangulationConfig{}); });
+  CHECK(why.find("the frame channel does not have these cameras") != std::string::npos);
   { VisionWorker w(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}); }
   CHECK_FALSE(ch->reader_claimed());
 }
@@ -126,6 +129,8 @@ TEST_CASE("cameras detected on helper threads of ours give the same key-points a
   REQUIRE(kps[0]->count > 20);
   REQUIRE(kps[0]->count == kps[1]->count);
   CHECK(std::memcmp(kps[0]->points, kps[1]->points, sizeof(crease::Keypoint) * kps[0]->count) == 0);
-  CHECK_THROWS_AS(VisionWorker(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}, -1),
-                  std::invalid_argument);
+  // The plugin reads camera_threads in [0, 64]: a negative count is a bug.
+  CHECK(crease::testing::abort_message([&] {
+          VisionWorker w(ch, small_rig(), s.layout, DetectorConfig{}, TriangulationConfig{}, -1);
+        }).find("camera_threads: expected 0") != std::string::npos);
 }
