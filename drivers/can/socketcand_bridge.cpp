@@ -10,20 +10,14 @@
 
 #include <cerrno>
 #include <cstring>
-#include <ctime>
 #include <stdexcept>
 #include <vector>
 
 #include "drivers/can/socketcand_protocol.h"
+#include "rt/clock.h"
 
 namespace crease::drivers {
 namespace {
-std::int64_t mono_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
-
 struct Client {
   int fd;
   socketcand::StreamSplitter splitter;
@@ -95,7 +89,7 @@ void SocketcandBridge::run() {
         queue_text(clients.back(), "< hi >");
       }
     }
-    const std::int64_t now = mono_ns();
+    const std::int64_t now = rt::now_ns();
     // Bus -> clients.
     RxFrame rx;
     for (int i = 0; i < 512; ++i) {

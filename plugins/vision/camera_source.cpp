@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/assert.h"
+#include "rt/clock.h"
 
 namespace crease::vision {
 
@@ -87,11 +87,6 @@ bool ReplaySource::grab(Frame& frame) {
 }
 
 namespace {
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
 }  // namespace
 
@@ -109,7 +104,7 @@ V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::strin
                             " s)");
   reconnects_ = std::make_unique<std::atomic<std::uint64_t>[]>(devices.size());
   devices_.resize(devices.size());
-  const std::int64_t now = monotonic_ns();
+  const std::int64_t now = crease::rt::now_ns();
   std::uint32_t dark = 0;
   for (std::size_t k = 0; k < devices.size(); ++k) {
     devices_[k].path = devices[k];
@@ -152,7 +147,7 @@ void V4l2Source::went_dark(std::size_t k, std::int64_t now_ns) {
 bool V4l2Source::grab(Frame& frame) {
   frame.index = next_++;
   frame.images.resize(devices_.size());
-  const std::int64_t before = monotonic_ns();
+  const std::int64_t before = crease::rt::now_ns();
   for (std::size_t k = 0; k < devices_.size(); ++k) {
     Device& d = devices_[k];
     if (d.open || before < d.retry_at_ns) continue;
@@ -173,7 +168,7 @@ bool V4l2Source::grab(Frame& frame) {
       ok[k] = false;
     }
   }
-  frame.timestamp_ns = monotonic_ns();
+  frame.timestamp_ns = crease::rt::now_ns();
   cv::Mat bgr;
   std::uint32_t dark = 0;
   for (std::size_t k = 0; k < devices_.size(); ++k) {
