@@ -356,4 +356,18 @@ const char* to_string(FaultPolicy p) noexcept {
   return "?";
 }
 
+void override_param(DaemonConfig& config, const std::string& assignment) {
+  const auto fail = [&](const std::string& why) { throw ConfigError("--set '" + assignment + "': " + why); };
+  const std::size_t dot = assignment.find('.'), eq = assignment.find('=');
+  if (dot == std::string::npos || eq == std::string::npos || dot == 0 || eq < dot + 2) fail("expected INSTANCE.KEY=VALUE");
+  const std::string instance = assignment.substr(0, dot), key = assignment.substr(dot + 1, eq - dot - 1);
+  for (PluginConfig& p : config.plugins) {
+    if (p.name != instance) continue;
+    if (!p.params || p.params.IsNull()) p.params = YAML::Node(YAML::NodeType::Map);
+    p.params[key] = YAML::Node(assignment.substr(eq + 1));
+    return;
+  }
+  fail("no plugin instance named '" + instance + "' in " + config.file);
+}
+
 }  // namespace crease::config

@@ -106,6 +106,11 @@ struct LoadOptions {
                                                           const std::string& virtual_file,
                                                           const LoadOptions& options = {});
 
+// Applies a command-line override `INSTANCE.KEY=VALUE` (creased --set): the plugin instance's
+// parameter KEY becomes VALUE read as a YAML scalar. The plugin validates it as any parameter.
+// Throws ConfigError naming the assignment when it is malformed or names no instance.
+void override_param(DaemonConfig& config, const std::string& assignment);
+
 [[nodiscard]] const char* to_string(OverrunPolicy p) noexcept;
 [[nodiscard]] const char* to_string(FaultPolicy p) noexcept;
 

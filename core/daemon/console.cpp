@@ -7,7 +7,7 @@ namespace {
 double us(std::uint64_t ns) { return double(ns) / 1000.0; }
 }  // namespace
 
-std::string progress_line(const PluginHost& host, double t_s, const TrackingSummary& tracking) {
+std::string progress_line(const PluginHost& host, double t_s, const std::vector<FigureReading>& figures) {
   std::string line = "[" + std::to_string(static_cast<int>(t_s)) + " s]";
   for (const Loop* l : host.loops()) {
     const auto snap = l->timing().wakeup_latency.snapshot();
@@ -18,13 +18,7 @@ std::string progress_line(const PluginHost& host, double t_s, const TrackingSumm
     line += buf;
   }
   line += " faults " + std::to_string(host.fault_count());
-  if (tracking.scored) {
-    char buf[160];
-    std::snprintf(buf, sizeof(buf), "; tracking error vs truth: %.2f mm (this second), %.2f mm (mean so far)",
-                  tracking.window_mean_mm, tracking.mean_mm);
-    line += buf;
-  }
-  return line;
+  return line + progress_text(figures);
 }
 
 void print_summary(const PluginHost& host, const SummaryFacts& f) {
@@ -47,16 +41,7 @@ void print_summary(const PluginHost& host, const SummaryFacts& f) {
     }
   }
   std::printf("  faults: %llu\n", (unsigned long long)host.fault_count());
-  const TrackingSummary& t = f.tracking;
-  if (t.scored) {
-    std::printf("  tracking error of sheet_state vs sheet_truth: mean %.2f mm over %llu model frames, last %.2f mm, "
-                "worst %.2f mm\n",
-                t.mean_mm, (unsigned long long)t.frames, t.last_mm, t.max_mm);
-  }
-  if (!f.record_state.empty()) {
-    std::printf("  recorded %llu model frames to %s (%llu not seen)\n", (unsigned long long)t.recorded,
-                f.record_state.c_str(), (unsigned long long)t.missed);
-  }
+  std::printf("%s", summary_text(f.figures).c_str());
   std::fflush(stdout);
 }
 

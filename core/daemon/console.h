@@ -4,25 +4,26 @@
 
 #include <string>
 
-#include "core/daemon/state_observer.h"
+#include <vector>
+
+#include "core/daemon/figures.h"
 #include "core/plugin_host.h"
 
 namespace crease::daemon {
 
-// "[T s] LOOP: N cycles, wake p99 X us, overruns K; ... faults F" and, when the tracking is
-// scored, the tracking error of the last second and the mean so far. T: seconds since start.
-[[nodiscard]] std::string progress_line(const PluginHost& host, double t_s, const TrackingSummary& tracking);
+// "[T s] LOOP: N cycles, wake p99 X us, overruns K; ... faults F" and each figure a plugin
+// reports (its last second and its mean so far). T: seconds since start.
+[[nodiscard]] std::string progress_line(const PluginHost& host, double t_s, const std::vector<FigureReading>& figures);
 
 struct SummaryFacts {
   double ran_s = 0;              // since start
   std::string stop_reason;       // "duration reached", "SIGINT", "creasectl stop", ...
-  TrackingSummary tracking;      // final
-  std::string record_state;      // the --record-state file, empty when none
+  std::vector<FigureReading> figures;  // final, read before the outputs went safe
 };
 
 // The summary table (per loop and per plugin: rate, cycles, wake-up and execution
-// percentiles, overruns, state, faults, swaps), the fault count, the tracking error and what
-// was recorded, printed to stdout.
+// percentiles, overruns, state, faults, swaps), the fault count and the plugins' figures,
+// printed to stdout.
 void print_summary(const PluginHost& host, const SummaryFacts& facts);
 
 }  // namespace crease::daemon

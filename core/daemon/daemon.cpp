@@ -105,7 +105,7 @@ int Daemon::run() {
     if (cpu && !step.applied) facts_.affinity_applied = false;
     log_step(step);
   }
-  observer_ = std::make_unique<StateObserver>(host_->ports(), options_.record_state, facts_.start_ns);
+  figures_ = std::make_unique<FigureWatch>(host_->ports());
   facts_.sched_fifo_applied &= any_fifo;
   facts_.affinity_applied &= any_cpu;
   spdlog::info("creased running: {} loops, {} plugins, control socket {}", config_.loops.size(), config_.plugins.size(),
@@ -160,19 +160,17 @@ int Daemon::run() {
   control::notify_stopping(stop_reason_);
   spdlog::info("stopping: {}", stop_reason_);
   server_->stop();
-  observer_->stop();  // takes the last model frame before outputs go safe
-  tracking_ = observer_->summary();
+  const std::vector<FigureReading> figures = figures_->take();  // before the outputs go safe
   host_->stop();  // drives every output safe, deactivates in reverse order
   host_->poll();
-  print_summary(*host_, {double(rt::now_ns() - facts_.start_ns) * 1e-9, stop_reason_, tracking_, options_.record_state});
+  print_summary(*host_, {double(rt::now_ns() - facts_.start_ns) * 1e-9, stop_reason_, figures});
   const std::optional<std::string> dir = options_.report_dir ? options_.report_dir : config_.daemon.report_dir;
   if (dir) write_reports(*host_, facts_, *dir);
   return 0;
 }
 
 void Daemon::print_progress(double t_s) {
-  if (observer_) tracking_ = observer_->take_window();
-  std::printf("%s\n", progress_line(*host_, t_s, tracking_).c_str());
+  std::printf("%s\n", progress_line(*host_, t_s, figures_->take()).c_str());
   std::fflush(stdout);
 }
 

@@ -15,7 +15,7 @@
 #include "core/config/daemon_config.h"
 #include "core/control/control_server.h"
 #include "core/daemon/report_builder.h"
-#include "core/daemon/state_observer.h"
+#include "core/daemon/figures.h"
 #include "core/plugin_host.h"
 
 namespace crease::daemon {
@@ -26,7 +26,6 @@ struct Options {
   std::optional<std::string> report_dir;  // overrides the configuration
   std::vector<std::string> plugin_dirs;   // when given, replace the configuration's
   bool progress = true;                   // a line per second on stdout
-  std::string record_state;               // write every model frame as JSON lines here
 };
 
 class Daemon final : public control::RequestHandler {
@@ -53,8 +52,7 @@ class Daemon final : public control::RequestHandler {
   Options options_;
   std::unique_ptr<PluginHost> host_;
   std::unique_ptr<control::ControlServer> server_;
-  std::unique_ptr<StateObserver> observer_;  // tracking error and --record-state
-  TrackingSummary tracking_;                 // final, after the observer stopped
+  std::unique_ptr<FigureWatch> figures_;     // the plugins' figures for progress and summary
   RunFacts facts_;
   std::atomic<bool> stop_{false};
   std::string stop_reason_ = "stopped";

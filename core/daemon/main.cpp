@@ -1,6 +1,6 @@
 // creased: the Crease daemon.
 //   creased --config FILE [--socket PATH] [--duration SECONDS] [--report-dir DIR]
-//           [--log-level LEVEL] [--plugin-dir DIR]... [--no-progress] [--record-state FILE]
+//           [--log-level LEVEL] [--plugin-dir DIR]... [--no-progress] [--set INSTANCE.KEY=VALUE]...
 // Exit status: 0 after a clean stop, 2 for a configuration or plugin error (nothing started),
 // 1 for any other failure.
 #include <signal.h>
@@ -8,6 +8,8 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
@@ -39,8 +41,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_option("--plugin-dir", options.plugin_dirs, "plugin directory (replaces the configuration's)");
   app.add_flag("--no-progress", no_progress, "no progress line every second");
-  app.add_option("--record-state", options.record_state,
-                 "write every sheet_state model frame as one JSON line to this file");
+  std::vector<std::string> overrides;
+  app.add_option("--set", overrides, "INSTANCE.KEY=VALUE: a plugin parameter instead of the configuration's "
+                                     "(repeatable), e.g. --set score.record=state.jsonl");
   CLI11_PARSE(app, argc, argv);
   if (!socket.empty()) options.socket = socket;
   if (duration > 0) options.duration_s = duration;
@@ -53,7 +56,9 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<crease::daemon::Daemon> daemon;
   try {
-    daemon = std::make_unique<crease::daemon::Daemon>(crease::config::load_daemon_config(config_file), options);
+    crease::config::DaemonConfig config = crease::config::load_daemon_config(config_file);
+    for (const std::string& o : overrides) crease::config::override_param(config, o);
+    daemon = std::make_unique<crease::daemon::Daemon>(std::move(config), options);
   } catch (const crease::Error& e) {  // ConfigError, LoadError, PortError
     std::fprintf(stderr, "creased: %s\n", e.what());
     return 2;

@@ -22,7 +22,7 @@ TEST_CASE("config/sim.yaml tracks the folding sheet and records every model fram
   const std::string cmd = std::string(CREASE_BIN_DIR) + "/creased --config " CREASE_SOURCE_DIR "/config/sim.yaml" +
                           " --plugin-dir " CREASE_PLUGIN_DIR " --socket " + (dir / "s.sock").string() +
                           " --report-dir " + (dir / "reports").string() + " --duration 12 --log-level warn" +
-                          " --record-state " + record.string() + " 2>&1";
+                          " --set score.record=" + record.string() + " 2>&1";
   FILE* f = popen(cmd.c_str(), "r");
   REQUIRE(f != nullptr);
   std::string out;
@@ -35,7 +35,8 @@ TEST_CASE("config/sim.yaml tracks the folding sheet and records every model fram
 
   // Progress every second with the tracking error, then the summary.
   CHECK(out.find("[5 s]") != std::string::npos);
-  CHECK(out.find("tracking error vs truth") != std::string::npos);
+  CHECK(out.find("tracking error of sheet_state vs sheet_truth: ") != std::string::npos);
+  CHECK(out.find("(this second)") != std::string::npos);
   std::smatch m;
   const std::string text = out;
   REQUIRE(std::regex_search(text, m, std::regex("tracking error of sheet_state vs sheet_truth: mean ([0-9.]+) mm over ([0-9]+)")));

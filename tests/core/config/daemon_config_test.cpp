@@ -260,3 +260,23 @@ TEST_CASE("error_at lets a plugin point into the config for a bad parameter") {
       cfg::error_at(c.file, p.params["gain"], "plugins[0].params.gain", "must be positive");
   CHECK(std::string(e.what()) == "sim.yaml:12:13: plugins[0].params.gain: must be positive");
 }
+
+TEST_CASE("--set INSTANCE.KEY=VALUE overrides one plugin parameter; a bad assignment names itself") {
+  auto c = cfg::load_daemon_config_from_string(kGood, "/etc/crease/set.yaml", kNoDirCheck);
+  cfg::override_param(c, "second.record=/tmp/state.jsonl");
+  cfg::override_param(c, "second.step=3");
+  cfg::override_param(c, "modeller.gain=2.5");  // an instance without params gains a map
+  CHECK(c.plugins[0].params["record"].as<std::string>() == "/tmp/state.jsonl");
+  CHECK(c.plugins[0].params["step"].as<int>() == 3);
+  CHECK(c.plugins[0].params["nested"]["a"][1].as<int>() == 2);  // the others untouched
+  CHECK(c.plugins[2].params["gain"].as<double>() == 2.5);
+  for (const char* bad : {"nobody.k=1", "second", "second.=1", ".k=1", "secondk=1"}) {
+    CAPTURE(bad);
+    try {
+      cfg::override_param(c, bad);
+      FAIL("must throw");
+    } catch (const crease::ConfigError& e) {
+      CHECK(std::string(e.what()).find(std::string("--set '") + bad + "'") != std::string::npos);
+    }
+  }
+}
