@@ -163,6 +163,7 @@ void OdeSheet::substep(double dts) noexcept {
       const double p = plastic_update(dl, plastic_[k], sp.plasticity_rate, sp.yield_strain * l);
       if (p != plastic_[k]) {
         plastic_[k] = p;
+        ++plastic_version_;
         dJointSetDBallDistance(joints_[k], l + p);
       }
     }

@@ -28,6 +28,7 @@ SheetModel::SheetModel(const SheetParams& params)
   require(s.plasticity_rate >= 0 && s.plasticity_rate < 1, "solver.plasticity_rate",
           "must be in [0, 1)");
   require(s.yield_strain >= 0, "solver.yield_strain", "must be >= 0");
+  require(s.plasticity_every >= 1, "solver.plasticity_every", "must be >= 1");
   require(s.damping_per_s >= 0, "solver.damping_per_s", "must be >= 0");
   require(params_.grid.areal_density_g_per_m2 > 0, "grid.areal_density_g_per_m2", "must be > 0");
   require(params_.grid.thickness_mm > 0, "grid.thickness_mm", "must be > 0");
@@ -243,8 +244,10 @@ void SheetModel::save_links_rt() noexcept {
     std::copy(plastic_.begin(), plastic_.end(), saved_plastic_.begin());
     saved_creases_ = creases_;
     saved_version_ = links_version_;
-  } else if (params_.solver.plasticity_rate > 0) {
+    saved_plastic_version_ = plastic_version_;
+  } else if (saved_plastic_version_ != plastic_version_) {
     std::copy(plastic_.begin(), plastic_.end(), saved_plastic_.begin());
+    saved_plastic_version_ = plastic_version_;
   }
 }
 
@@ -256,6 +259,7 @@ void SheetModel::restore_links_rt() noexcept {
   creases_ = saved_creases_;
   ++links_version_;  // backends re-read rest lengths and compliances
   saved_version_ = links_version_;
+  saved_plastic_version_ = plastic_version_;
 }
 
 bool SheetModel::state_finite() const noexcept {

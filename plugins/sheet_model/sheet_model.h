@@ -112,8 +112,8 @@ class SheetModel {
 
   // The link state (rest lengths, plastic elongations, stiffnesses, creases) kept for a
   // rollback: save_links_rt copies what changed since the last save (rest lengths,
-  // stiffnesses and creases when links_version() moved; plastic elongations every time
-  // plasticity is on, as the step updates them); restore_links_rt puts the saved copy back
+  // stiffnesses and creases when links_version() moved; plastic elongations when a step
+  // changed one); restore_links_rt puts the saved copy back
   // (backends re-read it). Positions are the caller's (set_positions). RT, no allocation.
   void save_links_rt() noexcept;
   void restore_links_rt() noexcept;
@@ -149,11 +149,13 @@ class SheetModel {
   double keypoint_gain_ = 10.0;
   const CollisionWorld* world_ = nullptr;
   std::uint64_t links_version_ = 0;
+  std::uint64_t plastic_version_ = 0;  // backends: +1 whenever a plastic elongation changed
 
  private:
   std::vector<double> saved_rest_, saved_plastic_, saved_stiffness_, saved_compliance_;
   CreaseSet saved_creases_;
   std::uint64_t saved_version_ = ~std::uint64_t{0};
+  std::uint64_t saved_plastic_version_ = ~std::uint64_t{0};
 };
 
 }  // namespace crease::sheet

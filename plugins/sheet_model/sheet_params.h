@@ -64,6 +64,10 @@ struct SolverParams {
   double yield_strain = 0.0;       // eps_Y
   double plasticity_rate = 0.0;    // a in [0, 1)
   bool plastic_bending_only = true;
+  // The plastic update runs after every this many substeps, counted across frames (1: after
+  // every substep). The rule depends on elongations only, not on time: a world stepping 1 ms
+  // frames of a few substeps can update every few ms and pay a fraction of the link pass.
+  int plasticity_every = 1;
   // How SheetRunner couples the observed key-points to the model (the model applies whatever
   // inputs it is given): see Coupling.
   Coupling coupling = Coupling::springs;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "sheet_state_writer.h"
 #include "xpbd_sheet.h"
 
 namespace crease::sheet {
@@ -112,39 +113,7 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
 }
 
 void SheetRunner::fill_state(std::int64_t now_ns, SheetState& out) noexcept {
-  const Grid& g = model_->grid();
-  out.timestamp_ns = now_ns;
-  out.step = steps_;
-  out.nodes_u = static_cast<std::uint16_t>(g.w);
-  out.nodes_v = static_cast<std::uint16_t>(g.h);
-  out.width_mm = static_cast<float>(g.width_mm);
-  out.height_mm = static_cast<float>(g.height_mm);
-  model_->compute_normals(normals_);
-  const auto x = model_->positions();
-  const int n = std::min<int>(g.count(), SheetState::kMaxNodes);
-  for (int i = 0; i < n; ++i) {
-    out.position_mm[i][0] = static_cast<float>(x[i].x);
-    out.position_mm[i][1] = static_cast<float>(x[i].y);
-    out.position_mm[i][2] = static_cast<float>(x[i].z);
-    out.normal[i][0] = static_cast<float>(normals_[i].x);
-    out.normal[i][1] = static_cast<float>(normals_[i].y);
-    out.normal[i][2] = static_cast<float>(normals_[i].z);
-  }
-  model_->compute_strains(strain_);
-  out.link_count = static_cast<std::uint32_t>(std::min<int>(model_->link_count(), SheetState::kMaxLinks));
-  for (std::uint32_t k = 0; k < out.link_count; ++k) out.strain[k] = static_cast<float>(strain_[k]);
-  out.crease_count = 0;
-  const CreaseSet& cs = model_->creases();
-  for (int c = 0; c < CreaseSet::kCapacity && out.crease_count < SheetState::kMaxCreases; ++c) {
-    if (!cs.used(c)) continue;
-    const CreaseLine& l = cs.line(c);
-    out.crease_id[out.crease_count] = c;
-    float* o = out.crease_mm[out.crease_count++];
-    o[0] = static_cast<float>(l.a.u);
-    o[1] = static_cast<float>(l.a.v);
-    o[2] = static_cast<float>(l.b.u);
-    o[3] = static_cast<float>(l.b.v);
-  }
+  write_sheet_state(*model_, normals_, strain_, now_ns, steps_, out);
   // Fit: mean distance of the used targets to the model's sheet points.
   double err = 0;
   int used = 0;

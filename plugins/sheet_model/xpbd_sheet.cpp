@@ -151,12 +151,17 @@ void XpbdSheet::project_targets() noexcept {
 void XpbdSheet::update_plasticity() noexcept {
   const double a = params_.solver.plasticity_rate;
   const double eps_y = params_.solver.yield_strain;
+  bool changed = false;
   for (const std::int32_t k : plastic_links_) {
     const double l = rest_[k];
     const double dl = norm(x_[topo_.b[k]] - x_[topo_.a[k]]) - l;
-    plastic_[k] = plastic_update(dl, plastic_[k], a, eps_y * l);
-    kernel_.set_rest(k, l + plastic_[k]);
+    const double p = plastic_update(dl, plastic_[k], a, eps_y * l);
+    if (p == plastic_[k]) continue;  // within its elastic region: rest length as it was
+    plastic_[k] = p;
+    kernel_.set_rest(k, l + p);
+    changed = true;
   }
+  if (changed) ++plastic_version_;
 }
 
 void XpbdSheet::detect_contacts(double dt) noexcept {
@@ -167,7 +172,8 @@ void XpbdSheet::detect_contacts(double dt) noexcept {
     const Vec3 d = x_[i] - x_detect_[i];
     moved2 = std::max(moved2, dot(d, d));
   }
-  const double frame_move = 1.5 * std::sqrt(vmax2) * dt;
+  const double push = substep_contacts_ != nullptr ? std::max(0.0, substep_contacts_->max_push_mm(dt)) : 0.0;
+  const double frame_move = 1.5 * std::sqrt(vmax2) * dt + push;
   const double frame_margin = std::min(2.0 + frame_move, 30.0);  // the per-frame rule
   const std::uint64_t wv = world_ != nullptr ? world_->version() : 0;
   const bool valid = detect_margin_mm_ >= 0 && world_ == detect_world_ && wv == detect_world_version_ &&
@@ -198,16 +204,19 @@ void XpbdSheet::step_rt(double dt) noexcept {
 
   const double damp = std::max(0.0, 1.0 - sp.damping_per_s * dts);
   const double vcap = sp.max_speed_mm_per_s;
+  const auto plastic_every = static_cast<std::uint64_t>(std::max(1, sp.plasticity_every));
   for (int s = 0; s < ns; ++s) {
     // seed 000 Eqs. 1-4 (keypoint_coupling.h)
     (void)coupling_.apply_rt(keypoints(), keypoint_stencils(), keypoint_gain_, dts, x_, v_, pinned_);
     predict_rt(x_, v_, prev_, pin_pos_, keep_, sp.gravity_mm_per_s2, damp, dts, simd_);  // seed 001 Eq. 1
     project_links();
     project_targets();
+    if (substep_contacts_ != nullptr) substep_contacts_->solve_rt(x_, prev_, w_, s, ns, dts);
     const int every = std::max(1, sp.self_collision_every);
     contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);
     update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit
-    if (!plastic_links_.empty()) update_plasticity();
+    ++substeps_done_;
+    if (!plastic_links_.empty() && substeps_done_ % plastic_every == 0) update_plasticity();
   }
 }
 

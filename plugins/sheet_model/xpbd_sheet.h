@@ -2,14 +2,16 @@
 // One frame of dt: N_s substeps of dt_s = dt / N_s, each:
 //   key-point velocities (seed 000 Eqs. 1-4) -> prediction (seed 001 Eq. 1) ->
 //   links, Gauss-Seidel, one pass, lambda = 0 per substep (seed 001 Eqs. 2-3) ->
-//   zero-length target springs (seed 001 Eq. 4) -> contacts (table, shapes; layers every
+//   zero-length target springs (seed 001 Eq. 4) -> external substep contacts, if set
+//   (substep_contacts.h: the world's fingers) -> contacts (table, shapes; layers every
 //   solver.self_collision_every substeps and on the last) -> velocities from positions ->
-//   plastic update (seed 001 III.C).
+//   plastic update (seed 001 III.C; every solver.plasticity_every substeps).
 // Link constants are rebuilt only when links_version() or dt_s change; target-spring
 // weights once per frame (rows interleaved so consecutive ones seldom share a node).
 // Contacts: candidates are detected with a margin that also covers a skin of motion (and,
 // for layers, the skin beside each triangle) and kept over frames while 2 mm + the largest
-// node move since the detection + 1.5 x this frame's largest possible move stays within
+// node move since the detection + 1.5 x this frame's largest possible move (plus what the
+// external substep contacts say they may push a node this frame) stays within
 // that margin (the per-frame rule, 2 mm + 1.5 x the frame's move, over the whole time they
 // are used); detected again when it does not, when the collision world changed (version())
 // or after set_positions. Every frame, the candidates that pass the per-frame rule are the
@@ -26,6 +28,7 @@
 #include "keypoint_coupling.h"
 #include "link_kernel.h"
 #include "sheet_model.h"
+#include "substep_contacts.h"
 
 namespace crease::sheet {
 
@@ -44,6 +47,9 @@ class XpbdSheet final : public SheetModel {
   LinkKernel& link_kernel() noexcept { return kernel_; }
   // The target and per-node passes without AVX2 even when the CPU has it (tests compare).
   void force_scalar_passes(bool on) noexcept { simd_ = !on && cpu_simd_; }
+  // Contacts solved by another library in every substep (substep_contacts.h); nullptr: none.
+  // Not owned; must outlive the model or be reset first. RT.
+  void set_substep_contacts(SubstepContacts* c) noexcept { substep_contacts_ = c; }
 
  private:
   void prepare_frame(double dt_s) noexcept;
@@ -69,6 +75,8 @@ class XpbdSheet final : public SheetModel {
   std::uint64_t prepared_version_ = ~std::uint64_t{0};
   double prepared_dt_ = 0.0;
   std::vector<std::int32_t> plastic_links_;  // elasto-plastic links
+  std::uint64_t substeps_done_ = 0;          // since construction (plasticity_every counts them)
+  SubstepContacts* substep_contacts_ = nullptr;
   ContactSolver contacts_;
   std::vector<Vec3> x_detect_;       // positions at the last contact detection
   double detect_margin_mm_ = -1.0;   // margin of the last detection; < 0: detect next frame

@@ -212,7 +212,8 @@ class PoisonedLinksSheet final : public SheetModel {
   explicit PoisonedLinksSheet(const SheetParams& p) : SheetModel(p), x_(flat_), v_(flat_.size()) {}
   void step_rt(double dt_s) noexcept override {
     for (Vec3& x : x_) x.z -= 10.0 * dt_s;
-    for (double& d : plastic_) d += 0.001;  // a legitimate plastic update every step
+    for (double& d : plastic_) d += 0.001;  // a legitimate plastic update every step,
+    ++plastic_version_;                      // announced as backends do
     if (++steps_ == 3) {
       x_[7].y = std::nan("");
       rest_[5] = std::nan("");
