@@ -1,0 +1,410 @@
+#include "plugins/sim_world/finger_contacts.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace crease::world {
+namespace {
+
+using sheet::cross;
+using sheet::dot;
+using sheet::norm;
+using sheet::normalized;
+
+constexpr int kMaxNodeContacts = FingerContacts::kMaxShapesPerNode + 1;  // + the table
+constexpr double kInactiveReachMm = 2.0;  // contacts this far apart still enter a node's block
+constexpr double kGapMm = 3.0;            // measure_rt: contacts this far apart still listed
+
+// Solves A x = b for the m x m leading block (partial pivoting). False if singular.
+bool solve_small(double a[kMaxNodeContacts][kMaxNodeContacts], double b[kMaxNodeContacts], int m) noexcept {
+  for (int c = 0; c < m; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < m; ++r)
+      if (std::fabs(a[r][c]) > std::fabs(a[piv][c])) piv = r;
+    if (!(std::fabs(a[piv][c]) > 0)) return false;
+    if (piv != c) {
+      for (int k = 0; k < m; ++k) std::swap(a[c][k], a[piv][k]);
+      std::swap(b[c], b[piv]);
+    }
+    for (int r = c + 1; r < m; ++r) {
+      const double f = a[r][c] / a[c][c];
+      for (int k = c; k < m; ++k) a[r][k] -= f * a[c][k];
+      b[r] -= f * b[c];
+    }
+  }
+  for (int c = m - 1; c >= 0; --c) {
+    double s = b[c];
+    for (int k = c + 1; k < m; ++k) s -= a[c][k] * b[k];
+    b[c] = s / a[c][c];
+  }
+  return true;
+}
+
+}  // namespace
+
+void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const WorldShape> shapes, const Config& cfg) {
+  cfg_ = cfg;
+  shapes_ = shapes.data();
+  const int shape_count = static_cast<int>(shapes.size());
+  sheet_ = &sheet;
+  const sheet::Grid& g = sheet.grid();
+  grid_w_ = g.w;
+  grid_h_ = g.h;
+  du_ = g.du;
+  dv_ = g.dv;
+  half_thickness_ = 0.5 * sheet.params().grid.thickness_mm;
+  const int n = sheet.node_count();
+  const double kg_per_mm2 = sheet.params().grid.areal_density_g_per_m2 * 1e-9;
+  node_area_mm2_.resize(n);
+  for (int i = 0; i < n; ++i) node_area_mm2_[i] = sheet.node_masses_kg()[i] / kg_per_mm2;
+  slot_of_node_.assign(n, -1);
+  touched_.resize(n);
+  shape_near_.assign(shape_count, 0);
+  pose_now_.resize(shape_count);
+  pose_before_.resize(shape_count);
+  load_.assign(shape_count, ShapeLoad{});
+  residual_.resize(static_cast<std::size_t>(n) * kMaxShapesPerNode);
+  cell_start_.assign(kMaxCells * kMaxCells + 1, 0);
+  cell_nodes_.assign(n, 0);
+  n_shapes_ = shape_count;
+}
+
+void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3> v, double dt) noexcept {
+  const WorldShape* shapes = shapes_;
+  for (int k = 0; k < n_touched_; ++k) slot_of_node_[touched_[k].node] = -1;
+  n_touched_ = 0;
+  max_push_mm_ = 0;
+  for (int s = 0; s < n_shapes_; ++s) {
+    load_[s] = ShapeLoad{};
+    shape_near_[s] = 0;
+  }
+  if (!cfg_.hand_contacts) return;
+
+  const int n = static_cast<int>(x.size());
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  double v2 = 0;
+  for (int i = 0; i < n; ++i) {
+    lo = {std::min(lo.x, x[i].x), std::min(lo.y, x[i].y), std::min(lo.z, x[i].z)};
+    hi = {std::max(hi.x, x[i].x), std::max(hi.y, x[i].y), std::max(hi.z, x[i].z)};
+    v2 = std::max(v2, dot(v[i], v[i]));
+  }
+  const double reach = half_thickness_ + cfg_.margin_mm + std::sqrt(v2) * dt;
+  // Buckets in x, y.
+  const double cx = std::max(8.0, (hi.x - lo.x) / kMaxCells + 1e-9), cy = std::max(8.0, (hi.y - lo.y) / kMaxCells + 1e-9);
+  const int nx = std::min(kMaxCells, static_cast<int>((hi.x - lo.x) / cx) + 1);
+  const int ny = std::min(kMaxCells, static_cast<int>((hi.y - lo.y) / cy) + 1);
+  auto cell_x = [&](double px) { return std::clamp(static_cast<int>((px - lo.x) / cx), 0, nx - 1); };
+  auto cell_y = [&](double py) { return std::clamp(static_cast<int>((py - lo.y) / cy), 0, ny - 1); };
+  std::fill(cell_start_.begin(), cell_start_.begin() + nx * ny + 1, 0);
+  for (int i = 0; i < n; ++i) ++cell_start_[cell_y(x[i].y) * nx + cell_x(x[i].x) + 1];
+  for (int c = 0; c < nx * ny; ++c) cell_start_[c + 1] += cell_start_[c];
+  for (int i = 0; i < n; ++i) cell_nodes_[cell_start_[cell_y(x[i].y) * nx + cell_x(x[i].x)]++] = i;
+  for (int c = nx * ny; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
+  cell_start_[0] = 0;
+
+  for (int s = 0; s < n_shapes_; ++s) {
+    const WorldShape& sh = shapes[s];
+    double bl[3], bh[3];
+    const double t0[3] = {sh.pose0.t.x, sh.pose0.t.y, sh.pose0.t.z}, t1[3] = {sh.pose1.t.x, sh.pose1.t.y, sh.pose1.t.z};
+    for (int a = 0; a < 3; ++a) {
+      const double e0 = half_extent(sh.geom, sh.pose0, a), e1 = half_extent(sh.geom, sh.pose1, a);
+      bl[a] = std::min(t0[a] - e0, t1[a] - e1) - reach;
+      bh[a] = std::max(t0[a] + e0, t1[a] + e1) + reach;
+    }
+    if (bh[0] < lo.x || bl[0] > hi.x || bh[1] < lo.y || bl[1] > hi.y || bh[2] < lo.z || bl[2] > hi.z) continue;
+    shape_near_[s] = 1;
+    // How far the shape's surface may move this step: its centre plus its turn at its extent.
+    const double d = std::fabs(sh.quat0[0] * sh.quat1[0] + sh.quat0[1] * sh.quat1[1] + sh.quat0[2] * sh.quat1[2] +
+                               sh.quat0[3] * sh.quat1[3]);
+    const double turn = 2.0 * std::acos(std::min(1.0, d));
+    const double radius = std::max({half_extent(sh.geom, sh.pose1, 0), half_extent(sh.geom, sh.pose1, 1),
+                                    half_extent(sh.geom, sh.pose1, 2)}) * 1.7320508075688772;
+    const double sweep = norm(sh.pose1.t - sh.pose0.t) + turn * radius;
+    max_push_mm_ = std::max(max_push_mm_, sweep);
+    const int ix0 = cell_x(bl[0]), ix1 = cell_x(bh[0]), iy0 = cell_y(bl[1]), iy1 = cell_y(bh[1]);
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      for (int ix = ix0; ix <= ix1; ++ix) {
+        const int c = iy * nx + ix;
+        for (int e = cell_start_[c]; e < cell_start_[c + 1]; ++e) {
+          const int node = cell_nodes_[e];
+          const Vec3& p = x[node];
+          if (p.x < bl[0] || p.x > bh[0] || p.y < bl[1] || p.y > bh[1] || p.z < bl[2] || p.z > bh[2]) continue;
+          // The patch reaches up to half a diagonal of a cell from the node.
+          const double patch = 0.5 * std::hypot(du_, dv_);
+          if (closest_surface(sh.geom, sh.pose1, p).distance_mm > reach + sweep + patch) continue;
+          int slot = slot_of_node_[node];
+          if (slot < 0) {
+            slot = n_touched_++;
+            slot_of_node_[node] = slot;
+            Touched& t = touched_[slot];
+            t.node = node;
+            t.n_shapes = 0;
+            const int i = node % grid_w_, j = node / grid_w_;
+            const Vec3 du = x[j * grid_w_ + std::min(i + 1, grid_w_ - 1)] - x[j * grid_w_ + std::max(i - 1, 0)];
+            const Vec3 dv = x[std::min(j + 1, grid_h_ - 1) * grid_w_ + i] - x[std::max(j - 1, 0) * grid_w_ + i];
+            t.eu = normalized(du);
+            t.ev = normalized(dv - dot(dv, t.eu) * t.eu);
+            t.en = cross(t.eu, t.ev);
+            t.ulo = i > 0 ? -0.5 * du_ : 0.0;
+            t.uhi = i < grid_w_ - 1 ? 0.5 * du_ : 0.0;
+            t.vlo = j > 0 ? -0.5 * dv_ : 0.0;
+            t.vhi = j < grid_h_ - 1 ? 0.5 * dv_ : 0.0;
+            t.area_mm2 = node_area_mm2_[node];
+          }
+          Touched& t = touched_[slot];
+          if (t.n_shapes >= kMaxShapesPerNode) {
+            ++dropped_;
+            continue;
+          }
+          t.shape[t.n_shapes++] = s;
+        }
+      }
+    }
+  }
+}
+
+double FingerContacts::max_push_mm(double) const noexcept { return n_touched_ > 0 ? max_push_mm_ : 0.0; }
+
+Vec3 FingerContacts::deepest_patch_point(const WorldShape& s, const Pose& pose, const Touched& t, Vec3 x) const noexcept {
+  Vec3 q = x;
+  for (int it = 0; it < 3; ++it) {
+    const Vec3 d = closest_core(s.geom, pose, q) - x;
+    const double pu = std::clamp(dot(d, t.eu), t.ulo, t.uhi), pv = std::clamp(dot(d, t.ev), t.vlo, t.vhi);
+    q = x + pu * t.eu + pv * t.ev;
+  }
+  return q;
+}
+
+FingerContacts::Geometry FingerContacts::geometry(const WorldShape& s, const Pose& pose, const Touched& t,
+                                                  Vec3 x) const noexcept {
+  const Vec3 q = deepest_patch_point(s, pose, t, x);
+  const SurfacePoint sp = closest_surface(s.geom, pose, q);
+  Geometry g;
+  g.point = sp.point;
+  g.pen = half_thickness_ - sp.distance_mm;
+  const double c = dot(sp.normal, t.en);
+  constexpr double kFaceOn = 0.5;  // cos 60 deg
+  if (std::fabs(c) >= kFaceOn) {
+    g.n = c > 0 ? t.en : -1.0 * t.en;
+    g.pen /= std::fabs(c);
+  } else {
+    g.n = sp.normal;
+  }
+  return g;
+}
+
+void FingerContacts::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w, int substep,
+                              int substeps, double dt_s) noexcept {
+  if (n_touched_ == 0) return;
+  const double a0 = static_cast<double>(substep) / substeps, a1 = static_cast<double>(substep + 1) / substeps;
+  for (int s = 0; s < n_shapes_; ++s) {
+    if (!shape_near_[s]) continue;
+    pose_before_[s] = substep == 0 ? shapes_[s].pose_at(a0) : pose_now_[s];
+    pose_now_[s] = shapes_[s].pose_at(a1);
+  }
+  const double weight = 1.0 / substeps;
+  for (int k = 0; k < n_touched_; ++k) {
+    const Touched& t = touched_[k];
+    if (!(w[t.node] > 0)) continue;
+    solve_node_rt(t, x, prev, w[t.node], dt_s, weight);
+  }
+}
+
+int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, bool& any) const noexcept {
+  int m = 0;
+  any = false;
+  const double inv_dts2 = 1.0 / (dts * dts);
+  for (int e = 0; e < t.n_shapes; ++e) {
+    const int si = t.shape[e];
+    const WorldShape& s = shapes_[si];
+    const Pose& pose = pose_now_[si];
+    const Geometry geo = geometry(s, pose, t, p);
+    if (geo.pen <= -kInactiveReachMm) continue;
+    Contact& k = c[m++];
+    k.n = geo.n;
+    k.pen = geo.pen;
+    // Compliance of the cover under this node: 1 / (N/mm) = mm/N = 1e-3 m/N (the sheet's unit).
+    k.alpha = 1e-3 / (s.stiffness_n_per_mm3 * t.area_mm2) * inv_dts2;
+    k.mu = cfg_.finger_friction ? s.friction : 0.0;
+    k.point = geo.point;
+    k.surface_move = geo.point - pose_before_[si].apply(pose.inverse_apply(geo.point));
+    k.shape = si;
+    any = any || geo.pen > 0;
+  }
+  if (m == 0) return 0;
+  const double pen_table = half_thickness_ + cfg_.table_height_mm - p.z;
+  if (pen_table > -kInactiveReachMm) {
+    Contact& k = c[m++];
+    k = Contact{};
+    k.n = {0, 0, 1};
+    k.pen = pen_table;
+    k.mu = cfg_.table_friction_on ? cfg_.table_friction : 0.0;
+    any = any || pen_table > 0;
+  }
+  return m;
+}
+
+Vec3 FingerContacts::normal_rt(Contact* c, int m, double w) noexcept {
+  // The block's LCP, active set by hand (at most m + 1 rounds).
+  bool active[kMaxNodeContacts];
+  for (int e = 0; e < m; ++e) active[e] = c[e].pen > 0;
+  double lambda[kMaxNodeContacts] = {};
+  for (int round = 0; round <= m; ++round) {
+    int idx[kMaxNodeContacts], na = 0;
+    for (int e = 0; e < m; ++e)
+      if (active[e]) idx[na++] = e;
+    double a[kMaxNodeContacts][kMaxNodeContacts], b[kMaxNodeContacts];
+    for (int r = 0; r < na; ++r) {
+      for (int q = 0; q < na; ++q) a[r][q] = w * dot(c[idx[r]].n, c[idx[q]].n) + (r == q ? c[idx[r]].alpha : 0.0);
+      b[r] = c[idx[r]].pen;
+    }
+    for (int e = 0; e < m; ++e) lambda[e] = 0;
+    if (na > 0 && !solve_small(a, b, na)) break;
+    int worst = -1;
+    for (int r = 0; r < na; ++r) {
+      lambda[idx[r]] = b[r];
+      if (b[r] < 0 && (worst < 0 || b[r] < lambda[worst])) worst = idx[r];
+    }
+    if (worst >= 0) {
+      active[worst] = false;
+      continue;
+    }
+    // An inactive contact the solution pushes into joins the block.
+    Vec3 move;
+    for (int e = 0; e < m; ++e) move += (w * lambda[e]) * c[e].n;
+    int join = -1;
+    for (int e = 0; e < m && join < 0; ++e)
+      if (!active[e] && c[e].pen - dot(c[e].n, move) > 1e-12) join = e;
+    if (join < 0) break;
+    active[join] = true;
+  }
+  Vec3 move;
+  for (int e = 0; e < m; ++e) {
+    c[e].lambda = std::max(0.0, lambda[e]);
+    move += (w * c[e].lambda) * c[e].n;
+  }
+  return move;
+}
+
+Vec3 FingerContacts::friction_rt(const Contact* c, int m, double w, double dts, Vec3 u0, Vec3* fric_on_node) noexcept {
+  // The prox problem of the header comment, in the tangent plane of the contact carrying the
+  // most. Returns the node's tangential correction; fric_on_node: each contact's share (mN).
+  for (int e = 0; e < m; ++e) fric_on_node[e] = Vec3{};
+  int main = -1;
+  double cap[kMaxNodeContacts];
+  double total_cap = 0;
+  for (int e = 0; e < m; ++e) {
+    cap[e] = w * c[e].mu * c[e].lambda;
+    total_cap += cap[e];
+    if (c[e].lambda > 0 && (main < 0 || c[e].lambda > c[main].lambda)) main = e;
+  }
+  if (main < 0 || !(total_cap > 0)) return {};
+  const Vec3 nm = c[main].n;
+  auto tangent = [&](Vec3 v) { return v - dot(v, nm) * nm; };
+  const Vec3 a = tangent(u0);
+  Vec3 s[kMaxNodeContacts];
+  for (int e = 0; e < m; ++e) s[e] = c[e].shape >= 0 ? tangent(c[e].surface_move) : Vec3{};
+  Vec3 u = a;
+  int stick = -1;
+  for (int e = 0; e < m && stick < 0; ++e) {
+    if (!(cap[e] > 0)) continue;
+    Vec3 g = a - s[e];
+    double merged = 0;
+    for (int j = 0; j < m; ++j) {
+      if (!(cap[j] > 0)) continue;
+      const Vec3 d = s[e] - s[j];
+      const double len = norm(d);
+      if (len < 1e-12) merged += cap[j];
+      else g -= (cap[j] / len) * d;
+    }
+    if (dot(g, g) <= merged * merged) stick = e;
+  }
+  if (stick >= 0) {
+    u = s[stick];
+  } else {  // Weiszfeld iterations: every contact slides
+    for (int it = 0; it < 30; ++it) {
+      Vec3 num = a;
+      double den = 1.0;
+      for (int j = 0; j < m; ++j) {
+        if (!(cap[j] > 0)) continue;
+        const double r = std::max(norm(u - s[j]), 1e-9);
+        num += (cap[j] / r) * s[j];
+        den += cap[j] / r;
+      }
+      u = (1.0 / den) * num;
+    }
+  }
+  // Each contact's share: sliders their full capacity towards their surface's move, the
+  // sticking one the rest.
+  const double to_force = 1.0 / (w * dts * dts);  // mm -> kg mm / s^2 = mN
+  Vec3 others;
+  for (int e = 0; e < m; ++e) {
+    if (e == stick || !(cap[e] > 0)) continue;
+    const Vec3 d = s[e] - u;
+    const double len = norm(d);
+    if (len > 1e-12) fric_on_node[e] = (cap[e] * to_force / len) * d;
+    others += fric_on_node[e];
+  }
+  if (stick >= 0) fric_on_node[stick] = to_force * (u - a) - others;
+  return u - a;
+}
+
+void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::span<const Vec3> prev, double w,
+                                   double dts, double weight) noexcept {
+  Vec3& p = x[t.node];
+  Contact c[kMaxNodeContacts];
+  Vec3 fric[kMaxNodeContacts];
+  int m = 0;
+  // Twice: the friction moves the node along the surfaces, and the second normal solve presses
+  // it where it ends up (under a tilted pad the first, before the friction put the node back
+  // under the pad's material point, would count the sheet's pull as compression).
+  for (int pass = 0; pass < 2; ++pass) {
+    bool any = false;
+    const int mm = gather_rt(t, p, dts, c, any);
+    if (!any) {
+      if (pass == 0) return;
+      break;
+    }
+    m = mm;
+    p += normal_rt(c, m, w);
+    p += friction_rt(c, m, w, dts, p - prev[t.node], fric);
+  }
+  // Reactions on the shapes, averaged over the step: mN -> N.
+  const double inv_dts2 = 1.0 / (dts * dts);
+  for (int e = 0; e < m; ++e) {
+    if (c[e].shape < 0) continue;
+    ShapeLoad& l = load_[c[e].shape];
+    const Vec3 f = (-1e-3 * weight) * fric[e];
+    l.friction_n += f;
+    l.friction_moment_nmm += cross(c[e].point, f);
+    l.normal_n += (-1e-3 * weight * c[e].lambda * inv_dts2) * c[e].n;
+  }
+}
+
+void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec3> x) noexcept {
+  n_residual_ = 0;
+  for (int k = 0; k < n_touched_; ++k) {
+    const Touched& t = touched_[k];
+    const Vec3 p = x[t.node];
+    for (int e = 0; e < t.n_shapes; ++e) {
+      const int si = t.shape[e];
+      const WorldShape& s = shapes_[si];
+      const Geometry geo = geometry(s, poses[si], t, p);
+      if (geo.pen <= -kGapMm) continue;
+      if (n_residual_ >= static_cast<int>(residual_.size())) {
+        ++dropped_;
+        continue;
+      }
+      residual_[n_residual_++] = {si, geo.point, geo.n, geo.pen, s.stiffness_n_per_mm3 * t.area_mm2};
+    }
+  }
+}
+
+void FingerContacts::end_step_rt(std::span<const Vec3> x) noexcept {
+  for (int s = 0; s < n_shapes_; ++s) pose_now_[s] = shapes_[s].pose1;
+  measure_rt(pose_now_, x);
+  for (int k = 0; k < n_residual_; ++k)
+    if (residual_[k].depth_mm > 0) ++load_[residual_[k].shape].nodes;
+}
+
+}  // namespace crease::world

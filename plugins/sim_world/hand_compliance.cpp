@@ -1,0 +1,144 @@
+#include "plugins/sim_world/hand_compliance.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace crease::world {
+namespace {
+
+constexpr int kN = HandCompliance::kJoints;
+constexpr double kEpsNmmPerRad = 1e-6;  // keeps a joint nothing acts on at its spring's zero
+
+// In-place Cholesky solve of the SPD system A x = b (A overwritten). False if not SPD.
+bool cholesky_solve(double a[kN][kN], double b[kN]) noexcept {
+  for (int j = 0; j < kN; ++j) {
+    double d = a[j][j];
+    for (int k = 0; k < j; ++k) d -= a[j][k] * a[j][k];
+    if (!(d > 0)) return false;
+    a[j][j] = std::sqrt(d);
+    for (int i = j + 1; i < kN; ++i) {
+      double s = a[i][j];
+      for (int k = 0; k < j; ++k) s -= a[i][k] * a[j][k];
+      a[i][j] = s / a[j][j];
+    }
+  }
+  for (int i = 0; i < kN; ++i) {
+    double s = b[i];
+    for (int k = 0; k < i; ++k) s -= a[i][k] * b[k];
+    b[i] = s / a[i][i];
+  }
+  for (int i = kN - 1; i >= 0; --i) {
+    double s = b[i];
+    for (int k = i + 1; k < kN; ++k) s -= a[k][i] * b[k];
+    b[i] = s / a[i][i];
+  }
+  return true;
+}
+
+}  // namespace
+
+void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact> contacts, const Joints& target,
+                              const Joints& stiffness, const Joints& tau_external, bool compliant, Joints& dq,
+                              std::span<double> force_n) noexcept {
+  const int nc = std::min<int>(static_cast<int>(contacts.size()), kMaxContacts);
+  for (int c = 0; c < nc; ++c) {
+    g_[c].fill(0.0);
+    kin.add_hand_jacobian_transpose(contacts[c].link, contacts[c].point, contacts[c].normal, g_[c]);
+  }
+  saturated_ = 0;
+  at_limit_ = 0;
+  if (!compliant) {
+    dq.fill(0.0);
+    for (int c = 0; c < nc; ++c) force_n[c] = contacts[c].stiffness_n_per_mm * std::max(0.0, contacts[c].depth_mm);
+    return;
+  }
+  const Joints old = dq;
+  enum State : unsigned char { free_joint, saturated, locked };
+  State st[kN];
+  double sign[kN], lock_at[kN];
+  for (int j = 0; j < kN; ++j) {
+    st[j] = free_joint;
+    sign[j] = 0;
+    lock_at[j] = 0;
+  }
+  bool on[kMaxContacts];
+  for (int c = 0; c < nc; ++c) on[c] = contacts[c].depth_mm > 0;
+  // Depth of contact c at deflection dq, linearised about the step's.
+  auto depth = [&](int c, const Joints& d) {
+    double s = contacts[c].depth_mm;
+    for (int j = 0; j < kN; ++j) s += g_[c][j] * (d[j] - old[j]);
+    return s;
+  };
+
+  Joints sol = old;
+  for (int round = 0; round < 3 * kN; ++round) {
+    double a[kN][kN] = {};
+    double r[kN];
+    for (int j = 0; j < kN; ++j) {
+      r[j] = tau_external[j];
+      a[j][j] = kEpsNmmPerRad + (st[j] == free_joint ? 1000.0 * std::max(0.0, stiffness[j]) : 0.0);
+      if (st[j] == saturated) r[j] -= 1000.0 * limits_.effort_nm[j] * sign[j];
+    }
+    for (int c = 0; c < nc; ++c) {
+      if (!on[c]) continue;
+      const double kc = contacts[c].stiffness_n_per_mm;
+      double gd = 0;
+      for (int j = 0; j < kN; ++j) gd += g_[c][j] * old[j];
+      const double rc = -kc * (contacts[c].depth_mm - gd);
+      for (int i = 0; i < kN; ++i) {
+        const double gi = g_[c][i];
+        if (gi == 0.0) continue;
+        r[i] += rc * gi;
+        for (int j = 0; j < kN; ++j) a[i][j] += kc * gi * g_[c][j];
+      }
+    }
+    for (int j = 0; j < kN; ++j) {
+      if (st[j] != locked) continue;
+      for (int i = 0; i < kN; ++i) {
+        if (i == j) continue;
+        r[i] -= a[i][j] * lock_at[j];
+        a[i][j] = a[j][i] = 0.0;
+      }
+      a[j][j] = 1.0;
+      r[j] = lock_at[j];
+    }
+    if (!cholesky_solve(a, r)) return;  // not expected: A is SPD by construction
+    for (int j = 0; j < kN; ++j) sol[j] = r[j];
+
+    bool changed = false;
+    for (int c = 0; c < nc; ++c) {
+      const double d = depth(c, sol);
+      if (on[c] != (d > 0)) {
+        on[c] = d > 0;
+        changed = true;
+      }
+    }
+    for (int j = 0; j < kN; ++j) {
+      const double q = target[j] + sol[j];
+      if (st[j] != locked && (q < limits_.lower_rad[j] || q > limits_.upper_rad[j])) {
+        st[j] = locked;
+        lock_at[j] = std::clamp(q, limits_.lower_rad[j], limits_.upper_rad[j]) - target[j];
+        changed = true;
+        continue;
+      }
+      const double k = 1000.0 * std::max(0.0, stiffness[j]), tmax = 1000.0 * limits_.effort_nm[j];
+      if (st[j] == free_joint && k * std::fabs(sol[j]) > tmax) {
+        st[j] = saturated;
+        sign[j] = sol[j] > 0 ? 1.0 : -1.0;
+        changed = true;
+      } else if (st[j] == saturated && sol[j] * sign[j] * k < tmax) {
+        st[j] = free_joint;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  dq = sol;
+  for (int j = 0; j < kN; ++j) {
+    saturated_ += st[j] == saturated;
+    at_limit_ += st[j] == locked;
+  }
+  for (int c = 0; c < nc; ++c) force_n[c] = on[c] ? contacts[c].stiffness_n_per_mm * std::max(0.0, depth(c, sol)) : 0.0;
+}
+
+}  // namespace crease::world

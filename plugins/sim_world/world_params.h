@@ -1,0 +1,67 @@
+// Parameters of the simulated world (plugins/sim_world): its time step, its sheet, the
+// contact stiffness of the robot's surfaces, the randomisation and the physics switches the
+// tests turn off one at a time. Units: mm, s, kg, N (forces), N m/rad (joint stiffness);
+// the sheet's own parameters as plugins/sheet_model/sheet_params.h (mm, s, kg, m/N).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "plugins/robot_model/robot_layout.h"
+#include "plugins/sheet_model/sheet_params.h"
+
+namespace crease::world {
+
+// The world's sheet: A4 80 g/m^2 on a 29 x 41 grid (7.5 mm between nodes; the tracking model's
+// is 15 x 21), lying on the table centred on the world origin, u along +x, v along -y.
+[[nodiscard]] inline sheet::SheetParams default_world_sheet() {
+  sheet::SheetParams p;
+  p.grid.nodes_u = 29;
+  p.grid.nodes_v = 41;
+  p.grid.origin_mm = {-105.0, 148.5, 0.5 * p.grid.thickness_mm};
+  p.solver.substeps = 2;                 // per world step: 0.5 ms
+  p.solver.max_speed_mm_per_s = 5000.0;  // above the arms' fastest motion (~3 m/s at the hand)
+  p.solver.yield_strain = 0.05;          // see README.md: bends tighter than ~20 mm over 22 mm yield
+  p.solver.plasticity_rate = 0.3;
+  p.solver.plasticity_every = 10;        // every 5 ms
+  return p;
+}
+
+struct WorldParams {
+  double dt_s = 0.001;  // one world step: one 1 kHz control cycle
+  sheet::SheetParams sheet = default_world_sheet();
+  double table_height_mm = 0.0;
+
+  // Contact stiffness of a surface pressed onto paper or the table: N per mm of compression
+  // per mm^2 of contact (a cover of Young's modulus E and thickness t: E / t). A sheet node
+  // carries its share of the sheet's area; a shape directly on the table carries
+  // table_contact_area_mm2. Keyed by the robot YAML's material names.
+  std::map<std::string, double> contact_stiffness_n_per_mm3 = {
+      {"rubber", 0.75}, {"fabric", 0.4}, {"plastic", 10.0}};
+  double table_contact_area_mm2 = 100.0;
+
+  // Arm and hand configuration before the first step (rad, drivers' orders).
+  std::array<std::array<double, robot::kArmJoints>, robot::kSides> initial_arm_rad{};
+  std::array<std::array<double, robot::kHandJoints>, robot::kSides> initial_hand_rad{};
+  double initial_stiffness_nm_per_rad = 1.0;
+
+  // Randomisation from one seed (randomise.h): the sheet's pose on the table, its stiffness and
+  // yield strain, every friction coefficient. Ranges are +- these.
+  bool randomise = true;
+  std::uint64_t seed = 1;
+  double sheet_offset_mm = 30.0;
+  double sheet_yaw_deg = 15.0;
+  double stiffness_fraction = 0.2;
+  double yield_fraction = 0.2;
+  double friction_fraction = 0.2;
+
+  // Physics switches, all on in the real world; each test turns one off for its failing variant.
+  bool hand_contacts = true;     // the hands' shapes push the sheet (and feel it)
+  bool finger_friction = true;   // Coulomb friction between the hands and the sheet
+  bool table_friction = true;    // Coulomb friction between the sheet and the table
+  bool joint_compliance = true;  // the hand joints are springs (else rigid at their targets)
+};
+
+}  // namespace crease::world

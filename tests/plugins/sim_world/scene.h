@@ -1,0 +1,212 @@
+// Test support for the world's physics tests: the shipped robot, arm inverse kinematics to
+// place a hand's tool frame (KDL's Levenberg-Marquardt solver on the arm's chain, the hand's
+// angles fixed), and the poses the scenes use. Non-RT; the scenes call the world's RT step.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <string>
+
+#include "plugins/robot_model/robot_model.h"
+#include "plugins/sim_world/sim_world.h"
+
+namespace scene {
+
+using namespace crease;
+using namespace crease::world;
+using Vec3 = crease::sheet::Vec3;
+using ArmQ = World::ArmJoints;
+using HandQ = World::HandJoints;
+
+inline const robot::RobotModel& robot_model() {
+  static const robot::RobotModel m =
+      robot::RobotModel::load(std::string(CREASE_SOURCE_DIR) + "/config/robot/crease_robot.yaml");
+  return m;
+}
+
+inline double deg(double d) { return d * std::numbers::pi / 180.0; }
+
+// Hand joint indices (drivers/README.md §3).
+enum HandJoint { WRJ2, WRJ1, FFJ4, FFJ3, FFJ2, MFJ4, MFJ3, MFJ2, RFJ4, RFJ3, RFJ2, LFJ5, LFJ4, LFJ3, LFJ2,
+                 THJ5, THJ4, THJ3, THJ2, THJ1 };
+
+// A rotation from its z axis (unit) and a vector near its x axis.
+inline KDL::Rotation frame_from_z_x(Vec3 z, Vec3 x_hint) {
+  const KDL::Vector zz = KDL::Vector(z.x, z.y, z.z) / std::sqrt(z.x * z.x + z.y * z.y + z.z * z.z);
+  KDL::Vector xx(x_hint.x, x_hint.y, x_hint.z);
+  xx = xx - KDL::dot(xx, zz) * zz;
+  xx.Normalize();
+  const KDL::Vector yy = zz * xx;
+  return KDL::Rotation(xx, yy, zz);
+}
+
+// Places a tool link of one side's hand at a pose by moving the arm only.
+class ArmIk {
+ public:
+  ArmIk(const robot::RobotModel& m, robot::Side side) : side_(side) {
+    const std::string prefix = m.params().side(side).prefix;
+    REQUIRE(m.tree().getChain("world", prefix + "flange", chain_));
+    REQUIRE(chain_.getNrOfJoints() == robot::kArmJoints);
+    solver_ = std::make_unique<KDL::ChainIkSolverPos_LMA>(chain_, 1e-9, 1000);
+    fk_ = std::make_unique<KDL::ChainFkSolverPos_recursive>(chain_);
+    kin_ = std::make_unique<SideKinematics>(m, side);
+    flange_ = kin_->link_index(prefix + "flange");
+    prefix_ = prefix;
+    const auto& j = m.arm_joints(side);
+    for (int i = 0; i < robot::kArmJoints; ++i) {
+      lo_[i] = j[i].lower_rad;
+      hi_[i] = j[i].upper_rad;
+    }
+  }
+
+  // Arm angles putting link TOOL's origin (without prefix) at p_mm with the palm turned to
+  // PALM, the hand at HAND, starting from GUESS. Fails the test when the solver does not reach
+  // it within 0.01 mm or leaves a joint's limits.
+  ArmQ solve(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess) {
+    const int t = kin_->link_index(prefix_ + tool), pl = kin_->link_index(prefix_ + "palm");
+    REQUIRE(t >= 0);
+    kin_->update_rt(guess, hand);
+    const KDL::Frame world_palm = to_frame(kin_->link_pose(pl));
+    const KDL::Frame palm_tool = world_palm.Inverse() * to_frame(kin_->link_pose(t));
+    const KDL::Frame palm_flange = world_palm.Inverse() * to_frame(kin_->link_pose(flange_));
+    const KDL::Vector p = KDL::Vector(p_mm.x, p_mm.y, p_mm.z) / 1000.0 - palm * palm_tool.p;
+    const KDL::Frame goal = KDL::Frame(palm, p) * palm_flange;
+    KDL::JntArray q0(robot::kArmJoints), q(robot::kArmJoints);
+    for (int i = 0; i < robot::kArmJoints; ++i) q0(i) = guess[i];
+    const int rc = solver_->CartToJnt(q0, goal, q);
+    ArmQ out{};
+    for (int i = 0; i < robot::kArmJoints; ++i) out[i] = q(i);
+    KDL::Frame reached;
+    REQUIRE(fk_->JntToCart(q, reached) >= 0);
+    const double err_mm = 1000.0 * (reached.p - goal.p).Norm();
+    if (!(err_mm < 0.01)) std::printf("ik: rc %d err %.4f mm\n", rc, err_mm);
+    REQUIRE(err_mm < 0.01);
+    for (int i = 0; i < robot::kArmJoints; ++i) {
+      REQUIRE(out[i] >= lo_[i]);
+      REQUIRE(out[i] <= hi_[i]);
+    }
+    return out;
+  }
+
+ private:
+  static KDL::Frame to_frame(const Pose& p) {
+    return KDL::Frame(KDL::Rotation(p.r[0], p.r[1], p.r[2], p.r[3], p.r[4], p.r[5], p.r[6], p.r[7], p.r[8]),
+                      KDL::Vector(p.t.x, p.t.y, p.t.z) / 1000.0);
+  }
+  robot::Side side_;
+  KDL::Chain chain_;
+  std::unique_ptr<KDL::ChainIkSolverPos_LMA> solver_;
+  std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk_;
+  std::unique_ptr<SideKinematics> kin_;
+  int flange_ = -1;
+  std::string prefix_;
+  ArmQ lo_{}, hi_{};
+};
+
+// A first guess of the arm near the workspace over the sheet (elbow bent, hand down).
+inline ArmQ arm_guess() { return {0.0, 0.5, 0.0, 1.4, 0.0, 1.2, 0.0}; }
+
+// Only the index finger out: the others bent back to their J3 limit (-15 deg).
+inline HandQ index_out() {
+  HandQ h{};
+  h[MFJ3] = h[RFJ3] = h[LFJ3] = deg(-15);
+  return h;
+}
+
+// The palm turned forward (+y) and down by BETA, its palmar face down and forward (either
+// hand: the left mirrors the right in its palm's x, so its thumb comes out on the other side).
+inline KDL::Rotation palm_forward_down(robot::Side, double beta) {
+  return frame_from_z_x({0, std::cos(beta), -std::sin(beta)}, {-1.0, 0, 0});
+}
+
+// A world with the working hand's tool TOOL at START (palm turned PALM, hand HAND) and the
+// other hand parked high beside the table; the nominal world unless PARAMS says otherwise.
+struct Rig {
+  Rig(WorldParams p, const std::string& tool_, Vec3 start, const KDL::Rotation& palm_, const HandQ& hand,
+      robot::Side side_ = robot::Side::right)
+      : params(std::move(p)), side(side_), ik(robot_model(), side_), ik_other(robot_model(), other(side_)),
+        tool(tool_), palm(palm_), hand_q(hand), last(start) {
+    const double sx = side == robot::Side::right ? -1.0 : 1.0;  // the other side's x sign
+    q = ik.solve(tool, start, palm, hand_q, arm_guess());
+    q_other = ik_other.solve("palm", {400 * sx, -150, 300}, frame_from_z_x({0, 0, -1}, {-sx, 0, 0}), other_hand,
+                             arm_guess());
+    const int me = static_cast<int>(side), them = static_cast<int>(other(side));
+    params.initial_arm_rad[me] = q;
+    params.initial_arm_rad[them] = q_other;
+    params.initial_hand_rad[me] = hand_q;
+    params.initial_hand_rad[them] = other_hand;
+    world = std::make_unique<World>(robot_model(), params);
+    stiffness.fill(params.initial_stiffness_nm_per_rad);
+    other_stiffness.fill(params.initial_stiffness_nm_per_rad);
+  }
+  static robot::Side other(robot::Side s) { return s == robot::Side::right ? robot::Side::left : robot::Side::right; }
+
+  // One step with the tool commanded to P (arm IK from the last solution), the hand at hand_q.
+  void step_to(Vec3 p) {
+    q = ik.solve(tool, p, palm, hand_q, q);
+    world->command_arm_rt(side, q);
+    world->command_hand_rt(side, hand_q, stiffness);
+    world->command_arm_rt(other(side), q_other);
+    world->command_hand_rt(other(side), other_hand, other_stiffness);
+    world->step_rt();
+  }
+  // Steps from the tool's last commanded point to P at SPEED mm/s, then holds for HOLD s.
+  void move(Vec3 p, double speed_mm_s, double hold_s = 0.0) {
+    const Vec3 from = last;
+    const double len = crease::sheet::norm(p - from);
+    const int n = std::max(1, static_cast<int>(std::ceil(len / (speed_mm_s * world->params().dt_s))));
+    for (int i = 1; i <= n; ++i) {
+      last = from + (static_cast<double>(i) / n) * (p - from);
+      step_to(last);
+    }
+    hold(hold_s);
+  }
+  void hold(double s) {
+    const int h = static_cast<int>(std::lround(s / world->params().dt_s));
+    for (int i = 0; i < h; ++i) step_to(last);
+  }
+  // The tool descends at SPEED from where it is until fingertip TIP touches; returns its z.
+  double descend_to_contact(int tip, double speed_mm_s, double floor_z) {
+    const double dz = speed_mm_s * world->params().dt_s;
+    while (last.z > floor_z && world->state().hand[static_cast<int>(side)].tip[tip].contact == 0) {
+      last.z -= dz;
+      step_to(last);
+    }
+    return last.z;
+  }
+  [[nodiscard]] const WorldHand& hand() const { return world->state().hand[static_cast<int>(side)]; }
+
+  WorldParams params;
+  robot::Side side;
+  ArmIk ik, ik_other;
+  std::string tool;
+  KDL::Rotation palm;
+  HandQ hand_q{}, other_hand{}, stiffness{}, other_stiffness{};
+  ArmQ q{}, q_other{};
+  Vec3 last;
+  std::unique_ptr<World> world;
+};
+
+// The mean position of the sheet's nodes (mm).
+inline Vec3 sheet_centroid(const World& w) {
+  Vec3 c;
+  const auto x = w.sheet().positions();
+  for (const Vec3& p : x) c += p;
+  return (1.0 / static_cast<double>(x.size())) * c;
+}
+
+inline WorldParams nominal() {
+  WorldParams p;
+  p.randomise = false;
+  return p;
+}
+
+}  // namespace scene
