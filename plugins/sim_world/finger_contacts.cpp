@@ -15,6 +15,10 @@ constexpr int kMaxNodeContacts = FingerContacts::kMaxShapesPerNode + 1;  // + th
 constexpr double kInactiveReachMm = 2.0;  // contacts this far apart still enter a node's block
 constexpr double kGapMm = 3.0;            // measure_rt: contacts this far apart still listed
 
+// Of two contacts of a node with one rigid body, is the one of penetration a the one to keep?
+// Both inside: the nearer exit; else the deeper (a penetrating one beats a gap).
+bool better_exit(double a, double b) noexcept { return a > 0 && b > 0 ? a < b : a > b; }
+
 // Solves A x = b for the m x m leading block (partial pivoting). False if singular.
 bool solve_small(double a[kMaxNodeContacts][kMaxNodeContacts], double b[kMaxNodeContacts], int m) noexcept {
   for (int c = 0; c < m; ++c) {
@@ -220,6 +224,16 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
     const Pose& pose = pose_now_[si];
     const Geometry geo = geometry(s, pose, t, p);
     if (geo.pen <= -kInactiveReachMm) continue;
+    // Shapes of one rigid body (a fingertip's cover, pad and back) overlap: a node inside two
+    // of them leaves through the nearer surface, never gets squeezed between them.
+    int same = -1;
+    for (int q = 0; q < m; ++q)
+      if (shapes_[c[q].shape].side == s.side && shapes_[c[q].shape].body == s.body) same = q;
+    if (same >= 0) {
+      if (!better_exit(geo.pen, c[same].pen)) continue;
+      --m;
+      if (same != m) c[same] = c[m];
+    }
     Contact& k = c[m++];
     k.n = geo.n;
     k.pen = geo.pen;
@@ -233,7 +247,8 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
   }
   if (m == 0) return 0;
   const double pen_table = half_thickness_ + cfg_.table_height_mm - p.z;
-  if (pen_table > -kInactiveReachMm) {
+  const double* e = cfg_.table_extent_mm;
+  if (pen_table > -kInactiveReachMm && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3]) {
     Contact& k = c[m++];
     k = Contact{};
     k.n = {0, 0, 1};
@@ -383,19 +398,49 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
 
 void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec3> x) noexcept {
   n_residual_ = 0;
+  const double* e = cfg_.table_extent_mm;
+  const double held_z = cfg_.table_height_mm + 5.0 * half_thickness_;  // on the table, or on a layer on it
   for (int k = 0; k < n_touched_; ++k) {
     const Touched& t = touched_[k];
     const Vec3 p = x[t.node];
-    for (int e = 0; e < t.n_shapes; ++e) {
-      const int si = t.shape[e];
-      const WorldShape& s = shapes_[si];
-      const Geometry geo = geometry(s, poses[si], t, p);
-      if (geo.pen <= -kGapMm) continue;
+    const bool held = p.z <= held_z && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3];
+    Geometry geo[kMaxShapesPerNode];
+    bool used[kMaxShapesPerNode] = {};
+    for (int s = 0; s < t.n_shapes; ++s) geo[s] = geometry(shapes_[t.shape[s]], poses[t.shape[s]], t, p);
+    for (int s = 0; s < t.n_shapes; ++s)  // one contact per rigid body (see gather_rt)
+      for (int o = 0; o < t.n_shapes; ++o) {
+        const WorldShape &a = shapes_[t.shape[s]], &b = shapes_[t.shape[o]];
+        if (o != s && !used[o] && a.side == b.side && a.body == b.body && better_exit(geo[o].pen, geo[s].pen))
+          used[s] = true;
+      }
+    for (int s = 0; s < t.n_shapes; ++s) {
+      if (used[s] || geo[s].pen <= -kGapMm) continue;
+      const WorldShape& a = shapes_[t.shape[s]];
+      const double ka = a.stiffness_n_per_mm3 * t.area_mm2;
       if (n_residual_ >= static_cast<int>(residual_.size())) {
         ++dropped_;
+        return;
+      }
+      Residual& r = residual_[n_residual_];
+      if (held) {
+        r = {t.shape[s], geo[s].point, geo[s].n, -1, {}, {}, geo[s].pen, ka};
+        ++n_residual_;
         continue;
       }
-      residual_[n_residual_++] = {si, geo.point, geo.n, geo.pen, s.stiffness_n_per_mm3 * t.area_mm2};
+      // Not held: a pinch needs a second shape of the same hand on the other side.
+      for (int o = s + 1; o < t.n_shapes; ++o) {
+        const WorldShape& b = shapes_[t.shape[o]];
+        // Two fingers (or a finger and the palm); a node in the crook of one finger is left to the
+        // substeps (its joints do not feel it).
+        const bool two = b.side == a.side && (a.finger != b.finger || a.finger < 0);
+        if (used[o] || !two || geo[o].pen <= -kGapMm || dot(geo[s].n, geo[o].n) > -0.3) continue;
+        const double kb = b.stiffness_n_per_mm3 * t.area_mm2;
+        r = {t.shape[s], geo[s].point, geo[s].n, t.shape[o], geo[o].point, geo[o].n, geo[s].pen + geo[o].pen,
+             ka * kb / (ka + kb)};
+        ++n_residual_;
+        used[s] = used[o] = true;
+        break;
+      }
     }
   }
 }
@@ -403,8 +448,11 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
 void FingerContacts::end_step_rt(std::span<const Vec3> x) noexcept {
   for (int s = 0; s < n_shapes_; ++s) pose_now_[s] = shapes_[s].pose1;
   measure_rt(pose_now_, x);
-  for (int k = 0; k < n_residual_; ++k)
-    if (residual_[k].depth_mm > 0) ++load_[residual_[k].shape].nodes;
+  for (int k = 0; k < n_residual_; ++k) {
+    if (residual_[k].depth_mm <= 0) continue;
+    ++load_[residual_[k].shape].nodes;
+    if (residual_[k].shape2 >= 0) ++load_[residual_[k].shape2].nodes;
+  }
 }
 
 }  // namespace crease::world

@@ -54,6 +54,7 @@ class FingerContacts final : public sheet::SubstepContacts {
 
   struct Config {
     double table_height_mm = 0;
+    double table_extent_mm[4] = {-1e9, 1e9, -1e9, 1e9};  // x_min, x_max, y_min, y_max
     double table_friction = 0.35;  // paper on the table
     bool hand_contacts = true;     // false: no shape touches the sheet
     bool finger_friction = true;
@@ -61,14 +62,21 @@ class FingerContacts final : public sheet::SubstepContacts {
     double margin_mm = 2.0;        // candidates: nodes this close (plus the step's motion)
   };
 
-  // A contact between a shape and a node: the shape's surface point, the direction the node is
-  // pushed (away from the shape), the depth the node sits inside it (the cover's compression,
-  // mm; negative: the gap, listed up to 3 mm so that the hands' balance sees a contact about
-  // to close) and the contact's stiffness (N/mm).
+  // A contact the hands' balance sees (measure_rt): a shape pressing a node that something
+  // holds (the table, or a layer lying on it), the node taken as fixed; or two shapes of two fingers
+  // (or a finger and the palm) pinching a node nothing else holds (shape2 >= 0), which then only passes the squeeze from one to
+  // the other. Per shape: its surface point and the direction it pushes the node (away from
+  // the shape). depth: the covers' compression (mm; a pinch: both together); negative: the gap,
+  // listed up to 3 mm so that the balance sees a contact about to close. stiffness: of the
+  // contact (N/mm; a pinch: both covers in series). A node nothing holds, touched by one shape,
+  // gives nothing: the finger pushes it away (its force, a few mg's inertia and the sheet's
+  // bending, is left to the substeps).
   struct Residual {
     int shape = -1;
     Vec3 point;
     Vec3 normal;
+    int shape2 = -1;
+    Vec3 point2, normal2;
     double depth_mm = 0;
     double stiffness_n_per_mm = 0;
   };

@@ -44,6 +44,8 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   for (int c = 0; c < nc; ++c) {
     g_[c].fill(0.0);
     kin.add_hand_jacobian_transpose(contacts[c].link, contacts[c].point, contacts[c].normal, g_[c]);
+    if (contacts[c].link2 >= 0)
+      kin.add_hand_jacobian_transpose(contacts[c].link2, contacts[c].point2, contacts[c].normal2, g_[c]);
   }
   saturated_ = 0;
   at_limit_ = 0;

@@ -40,10 +40,14 @@ class HandCompliance {
 
   // Contacts of this hand: residuals whose shape is compliant and on this side (the caller
   // filters), with their links. RT.
+  // One shape against a node held fixed; or (link2 >= 0) two shapes of the hand pinching a
+  // node between them: the same force on both, g = J1^T n1 + J2^T n2.
   struct Contact {
     int link = -1;
     Vec3 point, normal;
     double depth_mm = 0, stiffness_n_per_mm = 0;
+    int link2 = -1;
+    Vec3 point2, normal2;
   };
 
   // Solves for the new deflection. target, stiffness: the commanded ones (validated by the

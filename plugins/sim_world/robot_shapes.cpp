@@ -88,6 +88,7 @@ std::vector<WorldShape> build_robot_shapes(const robot::RobotModel& model,
     if (link < 0) throw ConfigError(model.urdf_file() + ": link '" + c.link + "': collision shape on no side's tree");
     s.side = side;
     s.link = link;
+    s.body = kin[side]->body_of(link);
     s.link_from_shape = c.link_from_shape;
     switch (c.kind) {
       case robot::ShapeKind::sphere:
@@ -120,6 +121,7 @@ std::vector<WorldShape> build_robot_shapes(const robot::RobotModel& model,
     if (local == "palm") s.role = ShapeRole::palm;
     for (int f = 0; f < robot::kFingertips; ++f) {
       const std::string tip(robot::kFingertipNames[f]);
+      if (local.rfind(tip, 0) == 0) s.finger = f;
       if (local == tip + "pad") s.role = ShapeRole::pad;
       if (local == tip + "back") s.role = ShapeRole::back;
       if (local == tip + "distal") s.role = ShapeRole::fingertip;

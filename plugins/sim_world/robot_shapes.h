@@ -32,11 +32,13 @@ struct WorldShape {
   Geom geom;
   int side = 0;  // robot::Side
   int link = -1;  // SideKinematics link index
+  int body = -1;  // its rigid body (SideKinematics::body_of): shapes of one body never pinch
   KDL::Frame link_from_shape;
   double friction = 0;  // Coulomb coefficient against paper (randomised)
   double stiffness_n_per_mm3 = 0;  // contact stiffness per mm^2 of contact (WorldParams)
   bool compliant = false;  // moved by a hand joint: its contacts deflect the hand
   int fingertip = -1;      // 0..4 (ff mf rf lf th) for pad, back and fingertip, else -1
+  int finger = -1;         // 0..4 for every link of that finger (knuckle to pad), else -1
   ShapeRole role = ShapeRole::arm;
   Pose pose0, pose1;       // at the step's start and end, world mm
   double quat0[4] = {1, 0, 0, 0}, quat1[4] = {1, 0, 0, 0};  // their rotations, (w, x, y, z)

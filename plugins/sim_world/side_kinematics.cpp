@@ -60,6 +60,7 @@ SideKinematics::SideKinematics(const robot::RobotModel& model, robot::Side side)
       s.hand_anc_count = p.hand_anc_count;
     }
     const int index = static_cast<int>(seg_.size());
+    s.body = s.source.kind != Source::none ? index : (parent >= 0 ? seg_[parent].body : -1);
     if (s.source.kind == Source::hand) {
       if (s.hand_anc_count >= kMaxAncestors) {
         throw ConfigError(model.urdf_file() + ": link '" + s.name + "': more than 12 hand joints above it");

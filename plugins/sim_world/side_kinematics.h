@@ -42,6 +42,9 @@ class SideKinematics {
   [[nodiscard]] const Pose& link_pose(int link) const noexcept { return pose_[link]; }
   [[nodiscard]] Pose compose(int link, const KDL::Frame& link_from_x_m) const noexcept;
 
+  // The rigid body a link belongs to: the nearest link at or above it whose joint moves (links
+  // on fixed joints, as the pads on their distal phalanx, share it); -1: fixed to the world.
+  [[nodiscard]] int body_of(int link) const noexcept { return seg_[link].body; }
   // True when some hand joint moves the link (the hand's links, from the wrist on).
   [[nodiscard]] bool moved_by_hand(int link) const noexcept { return seg_[link].hand_anc_count > 0; }
 
@@ -67,6 +70,7 @@ class SideKinematics {
     std::string name;
     KDL::Segment segment;
     int parent = -1;  // -1: the world frame
+    int body = -1;    // see body_of
     Source source;
     // The movable hand-joint segments between the world and this link (this one included).
     std::array<int, kMaxAncestors> hand_anc{};

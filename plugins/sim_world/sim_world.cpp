@@ -37,7 +37,18 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
   sp.solver.friction = params_.table_friction ? draws_.paper_table : 0.0;  // the sheet's own table contact
   sp.grid.origin_mm.z = params_.table_height_mm + 0.5 * sp.grid.thickness_mm;
   sheet_ = std::make_unique<sheet::XpbdSheet>(sp);
-  table_.add_table(params_.table_height_mm);
+  {
+    const auto& e = params_.table_extent_mm;
+    require(e[0] < e[1] && e[2] < e[3], "table_extent_mm", "must be {x_min, x_max, y_min, y_max}, min < max");
+    if (e[0] <= -WorldParams::kNoEdge && e[1] >= WorldParams::kNoEdge && e[2] <= -WorldParams::kNoEdge &&
+        e[3] >= WorldParams::kNoEdge) {
+      table_.add_table(params_.table_height_mm);
+    } else {  // a slab 50 mm deep under the top (wider ranges are cut to 2 m)
+      const double x0 = std::max(e[0], -1000.0), x1 = std::min(e[1], 1000.0);
+      const double y0 = std::max(e[2], -1000.0), y1 = std::min(e[3], 1000.0);
+      table_.add_box({x1 - x0, y1 - y0, 50.0}, {0.5 * (x0 + x1), 0.5 * (y0 + y1), params_.table_height_mm - 25.0});
+    }
+  }
   sheet_->set_collision_world(&table_);
 
   // The sheet's pose: the flat sheet turned about its centre by the yaw, then shifted.
@@ -90,6 +101,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
 
   FingerContacts::Config cfg;
   cfg.table_height_mm = params_.table_height_mm;
+  for (int k = 0; k < 4; ++k) cfg.table_extent_mm[k] = params_.table_extent_mm[k];
   cfg.table_friction = draws_.paper_table;
   cfg.hand_contacts = params_.hand_contacts;
   cfg.finger_friction = params_.finger_friction;
@@ -99,9 +111,12 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
   sheet_->set_substep_contacts(&contacts_);
 
   const std::size_t cap = static_cast<std::size_t>(sheet_->node_count()) * FingerContacts::kMaxShapesPerNode + shapes_.size();
-  hand_contacts_.resize(cap);
-  hand_contact_shape_.resize(cap);
-  hand_contact_force_.resize(cap);
+  for (int s = 0; s < robot::kSides; ++s) {
+    hand_contacts_[s].resize(cap);
+    hand_contact_shape_[s].resize(cap);
+    hand_contact_shape2_[s].resize(cap);
+    hand_contact_force_[s].resize(cap);
+  }
   shape_normal_n_.assign(shapes_.size(), 0.0);
   shape_normal_vec_n_.assign(shapes_.size(), Vec3{});
   last_good_.assign(sheet_->positions().begin(), sheet_->positions().end());
@@ -210,11 +225,21 @@ void World::settle_hand_rt(int side) noexcept {
   HandSim& h = hand_[side];
   const SideKinematics& kin = *kin_[side];
   int n = 0;
+  auto& contacts = hand_contacts_[side];
+  auto& shape_of = hand_contact_shape_[side];
+  auto& shape2_of = hand_contact_shape2_[side];
+  auto& force = hand_contact_force_[side];
   for (const FingerContacts::Residual& r : contacts_.residuals()) {
     const WorldShape& s = shapes_[r.shape];
     if (s.side != side || !s.compliant) continue;
-    hand_contacts_[n] = {s.link, r.point, r.normal, r.depth_mm, r.stiffness_n_per_mm};
-    hand_contact_shape_[n++] = r.shape;
+    contacts[n] = {s.link, r.point, r.normal, r.depth_mm, r.stiffness_n_per_mm, -1, {}, {}};
+    if (r.shape2 >= 0 && shapes_[r.shape2].compliant) {
+      contacts[n].link2 = shapes_[r.shape2].link;
+      contacts[n].point2 = r.point2;
+      contacts[n].normal2 = r.normal2;
+    }
+    shape_of[n] = r.shape;
+    shape2_of[n++] = r.shape2;
   }
   // The hand's own shapes on the table.
   for (int k = 0; k < static_cast<int>(shapes_.size()); ++k) {
@@ -224,29 +249,44 @@ void World::settle_hand_rt(int side) noexcept {
     shape_normal_vec_n_[k] = Vec3{};
     if (!params_.hand_contacts || !s.compliant) continue;
     const Vec3 low = lowest_point(s.geom, pose_pre_[k]);
+    if (!over_table(low)) continue;
     const double depth = params_.table_height_mm - low.z;
     if (depth <= -3.0) continue;  // a gap about to close counts too (hand_compliance.h)
-    hand_contacts_[n] = {s.link, low, {0, 0, -1}, depth, s.stiffness_n_per_mm3 * params_.table_contact_area_mm2};
-    hand_contact_shape_[n++] = k;
+    contacts[n] = {s.link, low, {0, 0, -1}, depth, s.stiffness_n_per_mm3 * params_.table_contact_area_mm2, -1, {}, {}};
+    shape_of[n] = k;
+    shape2_of[n++] = -1;
   }
   // Friction acts on the sheet and is reported per fingertip, but does not bend the joints:
   // fed back explicitly, a Coulomb force that flips with every small slip drives a finger as
   // soft sideways as these (a wrist of 1 N m/rad gives mm under 0.1 N) into a limit cycle.
-  compliance_[side]->solve_rt(kin, std::span<const HandCompliance::Contact>(hand_contacts_.data(), n), h.target,
+  compliance_[side]->solve_rt(kin, std::span<const HandCompliance::Contact>(contacts.data(), n), h.target,
                               h.stiffness, h.tau_external, params_.joint_compliance, h.deflection,
-                              std::span<double>(hand_contact_force_.data(), n));
+                              std::span<double>(force.data(), n));
   for (int c = 0; c < n; ++c) {
-    const int k = hand_contact_shape_[c];
-    shape_normal_n_[k] += hand_contact_force_[c];
-    shape_normal_vec_n_[k] -= hand_contact_force_[c] * hand_contacts_[c].normal;
+    const int k = shape_of[c], k2 = shape2_of[c];
+    shape_normal_n_[k] += force[c];
+    shape_normal_vec_n_[k] -= force[c] * contacts[c].normal;
+    if (k2 >= 0) {
+      shape_normal_n_[k2] += force[c];
+      shape_normal_vec_n_[k2] -= force[c] * contacts[c].normal2;
+    }
   }
+  n_settled_[side] = n;
+}
+
+bool World::over_table(Vec3 p) const noexcept {
+  const auto& e = params_.table_extent_mm;
+  return p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3];
 }
 
 void World::measure_penetration_rt() noexcept {
   double worst = 0;
   for (const FingerContacts::Residual& r : contacts_.residuals()) worst = std::max(worst, r.depth_mm);
   if (params_.hand_contacts) {
-    for (const WorldShape& s : shapes_) worst = std::max(worst, params_.table_height_mm - lowest_point(s.geom, s.pose1).z);
+    for (const WorldShape& s : shapes_) {
+      const Vec3 low = lowest_point(s.geom, s.pose1);
+      if (over_table(low)) worst = std::max(worst, params_.table_height_mm - low.z);
+    }
   }
   max_penetration_mm_ = worst;
 }
@@ -306,7 +346,7 @@ void World::fill_state_rt() noexcept {
   const double mm2_per_kg = 1.0 / (sheet_->params().grid.areal_density_g_per_m2 * 1e-9);
   double area = 0;
   for (std::size_t i = 0; i < x.size(); ++i)
-    if (x[i].z <= rest_z) area += m[i] * mm2_per_kg;
+    if (x[i].z <= rest_z && over_table(x[i])) area += m[i] * mm2_per_kg;
   state_.sheet_table_contact_area_mm2 = static_cast<float>(area);
 }
 

@@ -78,6 +78,18 @@ class World {
   // Worst depth (mm) of any hand shape in the sheet (beyond the covers' surface, i.e. into
   // the sheet's half thickness) or below the table, at the end of the last step.
   [[nodiscard]] double max_penetration_mm() const noexcept { return max_penetration_mm_; }
+  // The contacts side S settled against this step (hand_compliance.h), the shape of each (and
+  // the second shape of a pinch, else -1), and each one's normal force (N).
+  struct Settled {
+    std::span<const HandCompliance::Contact> contacts;
+    std::span<const int> shape, shape2;
+    std::span<const double> force_n;
+  };
+  [[nodiscard]] Settled settled(Side s) const noexcept {
+    const int i = index(s), n = n_settled_[i];
+    return {{hand_contacts_[i].data(), std::size_t(n)}, {hand_contact_shape_[i].data(), std::size_t(n)},
+            {hand_contact_shape2_[i].data(), std::size_t(n)}, {hand_contact_force_[i].data(), std::size_t(n)}};
+  }
   // The world's time, s.
   [[nodiscard]] double time_s() const noexcept { return state_.time_s; }
   // Test seam: the next step ends non-finite (as a physics blow-up would), to be rolled back.
@@ -104,6 +116,7 @@ class World {
   void pose_hands_rt() noexcept;
   void settle_hand_rt(int side) noexcept;
   void measure_penetration_rt() noexcept;
+  [[nodiscard]] bool over_table(Vec3 p) const noexcept;  // within the table top's extent in x, y
   void fill_state_rt() noexcept;
 
   const robot::RobotModel& model_;
@@ -118,9 +131,11 @@ class World {
   FingerContacts contacts_;
   std::array<HandSim, robot::kSides> hand_;
   std::array<std::unique_ptr<HandCompliance>, robot::kSides> compliance_;
-  std::vector<HandCompliance::Contact> hand_contacts_;  // one side's, this step
-  std::vector<int> hand_contact_shape_;
-  std::vector<double> hand_contact_force_;
+  // Per side, this step: the contacts the hand settled against, their shapes and forces (N).
+  std::array<std::vector<HandCompliance::Contact>, robot::kSides> hand_contacts_;
+  std::array<std::vector<int>, robot::kSides> hand_contact_shape_, hand_contact_shape2_;
+  std::array<std::vector<double>, robot::kSides> hand_contact_force_;
+  std::array<int, robot::kSides> n_settled_{};
   std::vector<double> shape_normal_n_;  // per shape: its normal load after the settle (N)
   std::vector<Vec3> shape_normal_vec_n_;
   std::vector<sheet::Vec3> last_good_, normals_;

@@ -33,6 +33,10 @@ struct WorldParams {
   double dt_s = 0.001;  // one world step: one 1 kHz control cycle
   sheet::SheetParams sheet = default_world_sheet();
   double table_height_mm = 0.0;
+  // The table top's extent in x and y (mm): {x_min, x_max, y_min, y_max}; infinite: a plane.
+  // Finite, the sheet can hang over an edge (a corner to pinch from above and below).
+  std::array<double, 4> table_extent_mm = {-kNoEdge, kNoEdge, -kNoEdge, kNoEdge};
+  static constexpr double kNoEdge = 1e9;
 
   // Contact stiffness of a surface pressed onto paper or the table: N per mm of compression
   // per mm^2 of contact (a cover of Young's modulus E and thickness t: E / t). A sheet node

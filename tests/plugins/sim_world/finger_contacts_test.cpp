@@ -32,8 +32,11 @@ sheet::SheetParams small_sheet(double grammage) {
   return p;
 }
 
-WorldShape sphere_at(Vec3 c, double r, double mu, double k_area) {
+// A shape on its own body (two of them pinch; one body's shapes never do).
+WorldShape sphere_at(Vec3 c, double r, double mu, double k_area, int body = 0) {
   WorldShape s;
+  s.body = body;
+  s.finger = body;
   s.geom = {GeomKind::sphere, r, 0.0, {}};
   s.pose0.t = s.pose1.t = c;
   s.friction = mu;
@@ -91,13 +94,29 @@ TEST_CASE("a node pinched between two equal covers sits between them, loaded equ
   p.solver.gravity_mm_per_s2 = {0, 0, 0};
   p.grid.origin_mm.z = 20.0;  // off the table
   // Spheres above and below the centre node (at z 20), each 0.3 mm into its surface.
-  Bench b(p, {sphere_at({20, -20, 20 + 0.5 + 5 - 0.3}, 5.0, 0.0, 0.5), sphere_at({20, -20, 20 - 0.5 - 5 + 0.3}, 5.0, 0.0, 0.5)});
+  Bench b(p, {sphere_at({20, -20, 20 + 0.5 + 5 - 0.3}, 5.0, 0.0, 0.5, 0), sphere_at({20, -20, 20 - 0.5 - 5 + 0.3}, 5.0, 0.0, 0.5, 1)});
   b.step();
   CHECK(b.sheet.positions()[12].z == doctest::Approx(20.0).epsilon(1e-6));
   const double up = b.fc.load(0).normal_n.z, down = b.fc.load(1).normal_n.z;
   CHECK(up > 0.0);  // the upper shape is pushed up
   CHECK(down == doctest::Approx(-up).epsilon(1e-6));
   CHECK(up == doctest::Approx(50.0 * 0.3).epsilon(1e-2));
+  // The hands' balance sees one pinch: both shapes, both depths, the covers in series.
+  const auto res = b.fc.residuals();
+  REQUIRE(res.size() >= 1);
+  bool pinch = false;
+  for (const auto& r : res)
+    pinch = pinch || (r.shape2 >= 0 && r.depth_mm == doctest::Approx(0.6).epsilon(1e-2) && r.stiffness_n_per_mm == doctest::Approx(25.0));
+  CHECK(pinch);
+}
+
+TEST_CASE("one body's shapes (a fingertip's cover and pad) never pinch a node between them") {
+  sheet::SheetParams p = small_sheet(80.0);
+  p.solver.gravity_mm_per_s2 = {0, 0, 0};
+  p.grid.origin_mm.z = 20.0;
+  Bench b(p, {sphere_at({20, -20, 20 + 0.5 + 5 - 0.3}, 5.0, 0.0, 0.5, 3), sphere_at({20, -20, 20 - 0.5 - 5 + 0.3}, 5.0, 0.0, 0.5, 3)});
+  b.step();
+  CHECK(b.fc.residuals().empty());  // the same spheres on two bodies make a pinch (above)
 }
 
 TEST_CASE("a tilted face presses the sheet down; it does not squeeze it out sideways") {

@@ -1,0 +1,100 @@
+// A pinch of the sheet's corner between the right thumb and index holds it by friction: the
+// corner hangs 48.5 mm over the table's near edge; the index, curled with its pad up, goes
+// under it, the thumb closes on it from above, and the hand lifts 50 mm at 5 mm/s and pulls
+// 60 mm away at 20 mm/s. The pinched sheet point goes with the pads.
+// Failing variant: frictionless fingers: the sheet slides out of the same pinch.
+#include <cmath>
+#include <string>
+
+#include "scene.h"
+
+using namespace scene;
+
+namespace {
+
+// The pinch found by a search over the index's and thumb's joints (pads facing, 4 mm apart at
+// THJ5 0.696); THJ5 opens (0.3) and closes it.
+HandQ pinch_hand(double thj5) {
+  HandQ h = index_out();
+  h[FFJ4] = 0.201;
+  h[FFJ3] = 1.428;
+  h[FFJ2] = 0.321;
+  h[THJ5] = thj5;
+  h[THJ4] = 1.072;
+  h[THJ3] = 0.027;
+  h[THJ2] = -0.549;
+  h[THJ1] = -0.117;
+  return h;
+}
+
+// The palm hanging down, turned so that the thumb pad faces straight down onto the index pad.
+KDL::Rotation pinch_palm(const HandQ& h) {
+  const KDL::Rotation r0 = frame_from_z_x({0, 0, -1}, {1, 0, 0});
+  SideKinematics k(robot_model(), robot::Side::right);
+  k.update_rt(ArmQ{}, h);
+  const Pose& palm = k.link_pose(k.link_index("r_palm"));
+  const Pose& th = k.link_pose(k.link_index("r_thpad"));
+  const KDL::Rotation rp(palm.r[0], palm.r[1], palm.r[2], palm.r[3], palm.r[4], palm.r[5], palm.r[6], palm.r[7],
+                         palm.r[8]);
+  const KDL::Vector n = r0 * (rp.Inverse() * KDL::Vector(th.r[2], th.r[5], th.r[8])), down(0, 0, -1);
+  const KDL::Vector axis = n * down;
+  return KDL::Rotation::Rot2(axis / axis.Norm(), std::atan2(axis.Norm(), KDL::dot(n, down))) * r0;
+}
+
+struct Pinch {
+  double force_n = 0;  // squeeze between the pads once closed
+  double rise_mm = 0;  // of the pinched sheet point over the 50 mm lift
+  double slip_mm = 0;  // of that point relative to the index pad, over the lift and the pull
+};
+
+Pinch pinch(WorldParams p) {
+  p.table_extent_mm = {-WorldParams::kNoEdge, WorldParams::kNoEdge, -95.0, WorldParams::kNoEdge};
+  p.initial_stiffness_nm_per_rad = 1.0;
+  const Vec3 at{87, -134, -8};  // 18 mm inside the sheet's right edge, 14.5 mm inside its near edge
+  Rig rig(p, "ffpad", at, pinch_palm(pinch_hand(0.696)), pinch_hand(0.3));
+  rig.hold(0.3);                                // the overhang settles
+  rig.move({at.x, at.y, -1.2}, 10.0, 0.1);      // the index pad under it
+  for (int i = 1; i <= 500; ++i) {              // the thumb closes in 0.4 s, 0.1 s more to settle
+    rig.hand_q[THJ5] = 0.3 + (0.77 - 0.3) * std::min(1.0, i / 400.0);
+    rig.step_to(rig.last);
+  }
+  Pinch out;
+  out.force_n = rig.hand().tip[0].normal_force_n;
+  const auto x = rig.world->sheet().positions();
+  int node = 0;
+  for (int i = 1; i < rig.world->sheet().node_count(); ++i)
+    if (sheet::norm(x[i] - Vec3{at.x, at.y, 0}) < sheet::norm(x[node] - Vec3{at.x, at.y, 0})) node = i;
+  auto pad = [&] {
+    const float* p3 = rig.hand().tip[0].position_mm;
+    return Vec3{p3[0], p3[1], p3[2]};
+  };
+  const Vec3 z0 = rig.world->sheet().positions()[node];
+  const Vec3 rel0 = z0 - pad();
+  rig.move({at.x, at.y, 48.8}, 5.0, 0.2);
+  out.rise_mm = rig.world->sheet().positions()[node].z - z0.z;
+  rig.move({at.x, at.y - 60, 48.8}, 20.0, 0.3);
+  out.slip_mm = sheet::norm((rig.world->sheet().positions()[node] - pad()) - rel0);
+  return out;
+}
+
+void print(const std::string& tag, const Pinch& p) {
+  MESSAGE(tag << ": pinch " << p.force_n << " N; the pinched point rose " << p.rise_mm
+              << " mm of 50, slipped " << p.slip_mm << " mm over the lift and a 60 mm pull");
+}
+
+bool holds(const Pinch& p) { return p.rise_mm > 40.0 && p.slip_mm < 10.0; }
+
+}  // namespace
+
+TEST_CASE("a pinch of a corner between thumb and index holds it by friction; frictionless it slips out") {
+  const Pinch held = pinch(nominal());
+  print("pinch", held);
+  CHECK(held.force_n > 0.1);
+  CHECK(holds(held));
+
+  WorldParams slippery = nominal();
+  slippery.finger_friction = false;
+  const Pinch lost = pinch(slippery);
+  print("frictionless fingers", lost);
+  CHECK_FALSE(holds(lost));
+}
