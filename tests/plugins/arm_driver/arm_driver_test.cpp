@@ -14,7 +14,7 @@
 #include "drivers/simdevice/sim_arm.h"
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
-#include "tests/drivers/hil/command_tap.h"
+#include "tests/drivers/hil/tapped_driver_rig.h"
 #include "tests/drivers/hil/driver_plugin_rig.h"
 
 using namespace crease;
@@ -75,64 +75,42 @@ ArmCommand command_with(float offset) {
   for (int j = 0; j < ArmCommand::kJoints; ++j) c.position_rad[j] = target_of(j, offset);
   return c;
 }
-template <class P>
-bool eventually(P pred) {
-  for (int i = 0; i < 5000 && !pred(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  return pred();
-}
+using HoldRig = test::TappedDriverRig<dr::sim::SimArm, dr::sim::SimArmConfig, dr::arm::Command, ArmCommand, ArmState>;
+using test::eventually;
 }  // namespace
 
 // As for the hand: seen on the device side, a set point written once is the set point of every
 // frame after it (never joint zero on the cycles when nothing new arrived).
 TEST_CASE("arm_driver: a set point written once is held unchanged, frame after frame, for 1000 cycles") {
-  const std::string bus = "plug-arm-hold-" + std::to_string(::getpid());
-  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
-  dr::MockCanBus dev_bus({bus, 10, 1'000'000, 5'000'000});
-  dr::testing::CommandTap<dr::arm::Command> tap(dev_bus, 10, &matches_held, &all_zero);
-  dr::sim::SimArm arm_dev(tap, {.node = 10});
-  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { arm_dev.step(t); });
-
-  Rig rig("arm_r", "arm_driver", "arm_state");
-  rig.add("{bus: " + bus + ", node: 10, timeout_cycles: 100}");
-  auto* cmd = rig.host.ports().bind_latest_writer("arm_command", port_type_of<ArmCommand>(), "test");
-  rig.host.start();
-  REQUIRE(eventually([&] { return rig.state().drive_state == 4; }));  // operation enabled
-  const ArmCommand once = command_with(0.0f);
-  cmd->write(&once, rt::now_ns());
+  HoldRig r("plug-arm-hold", 10, "arm_r", "arm_driver", "arm_state", "arm_command", &matches_held, &all_zero);
+  auto& tap = r.tap;
+  r.rig.host.start();
+  REQUIRE(eventually([&] { return r.rig.state().drive_state == 4; }));  // operation enabled
+  r.write(command_with(0.0f));
   REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
   tap.arm();
   const auto start = tap.total.load();
   REQUIRE(eventually([&] { return tap.total.load() >= start + 1000; }));
-  rig.host.stop();
+  r.rig.host.stop();
   CHECK(tap.matching.load() >= 1000);
   CHECK(tap.differing.load() == 0);
   CHECK(tap.zeros.load() == 0);
 }
 
 TEST_CASE("arm_driver: a 60 Hz set-point writer never produces a zero set point at 1 kHz") {
-  const std::string bus = "plug-arm-60-" + std::to_string(::getpid());
-  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
-  dr::MockCanBus dev_bus({bus, 10, 1'000'000, 5'000'000});
-  dr::testing::CommandTap<dr::arm::Command> tap(dev_bus, 10, &matches_held, &all_zero);
-  dr::sim::SimArm arm_dev(tap, {.node = 10});
-  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { arm_dev.step(t); });
-
-  Rig rig("arm_r", "arm_driver", "arm_state");
-  rig.add("{bus: " + bus + ", node: 10, timeout_cycles: 100}");
-  auto* cmd = rig.host.ports().bind_latest_writer("arm_command", port_type_of<ArmCommand>(), "test");
-  rig.host.start();
-  REQUIRE(eventually([&] { return rig.state().drive_state == 4; }));
-  const ArmCommand first = command_with(0.0f);
-  cmd->write(&first, rt::now_ns());
+  HoldRig r("plug-arm-60", 10, "arm_r", "arm_driver", "arm_state", "arm_command", &matches_held, &all_zero);
+  auto& tap = r.tap;
+  r.rig.host.start();
+  REQUIRE(eventually([&] { return r.rig.state().drive_state == 4; }));  // operation enabled
+  r.write(command_with(0.0f));
   REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
   tap.arm();
   const auto frames_before = tap.total.load();
   for (int i = 1; i <= 60; ++i) {
     std::this_thread::sleep_for(std::chrono::microseconds(16'667));
-    const ArmCommand c = command_with(0.05f * std::sin(0.3f * static_cast<float>(i)));
-    cmd->write(&c, rt::now_ns());
+    r.write(command_with(0.05f * std::sin(0.3f * static_cast<float>(i))));
   }
-  rig.host.stop();
+  r.rig.host.stop();
   CHECK(tap.total.load() - frames_before > 500);
   CHECK(tap.zeros.load() == 0);
 }

@@ -15,7 +15,7 @@
 #include "drivers/simdevice/sim_hand.h"
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
-#include "tests/drivers/hil/command_tap.h"
+#include "tests/drivers/hil/tapped_driver_rig.h"
 #include "tests/drivers/hil/driver_plugin_rig.h"
 
 using namespace crease;
@@ -81,38 +81,24 @@ HandCommand command_with(float offset) {
   }
   return c;
 }
-// Waits (at most 5 s) until pred() holds.
-template <class P>
-bool eventually(P pred) {
-  for (int i = 0; i < 5000 && !pred(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  return pred();
-}
+using HoldRig = test::TappedDriverRig<dr::sim::SimHand, dr::sim::SimHandConfig, dr::hand::Command, HandCommand, HandState>;
+using test::eventually;
 }  // namespace
 
 // The device side sees every command frame: a command written once must be the command of
 // every cycle after it (the driver must not fall back to a default, all-zero command on the
-// cycles when nothing new arrived). timeout_cycles is wide so that a late wake-up of a loaded
-// machine does not put the link into its safe state during the count.
+// cycles when nothing new arrived).
 TEST_CASE("hand_driver: a command written once is held unchanged, frame after frame, for 1000 cycles") {
-  const std::string bus = "plug-hand-hold-" + std::to_string(::getpid());
-  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
-  dr::MockCanBus dev_bus({bus, 1, 1'000'000, 5'000'000});
-  dr::testing::CommandTap<dr::hand::Command> tap(dev_bus, 1, &matches_held, &all_zero);
-  dr::sim::SimHand hand(tap, {.node = 1});
-  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
-
-  Rig rig("hand_r", "hand_driver", "hand_state");
-  rig.add("{bus: " + bus + ", node: 1, timeout_cycles: 100}");
-  auto* cmd = rig.host.ports().bind_latest_writer("hand_command", port_type_of<HandCommand>(), "test");
-  rig.host.start();
-  REQUIRE(eventually([&] { return rig.state().health == DeviceHealth::ok; }));
-  const HandCommand once = command_with(0.0f);
-  cmd->write(&once, rt::now_ns());
+  HoldRig r("plug-hand-hold", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero);
+  auto& tap = r.tap;
+  r.rig.host.start();
+  REQUIRE(eventually([&] { return r.rig.state().health == DeviceHealth::ok; }));
+  r.write(command_with(0.0f));
   REQUIRE(eventually([&] { return tap.matching.load() > 0; }));  // the command reached the device
   tap.arm();
   const auto start = tap.total.load();
   REQUIRE(eventually([&] { return tap.total.load() >= start + 1000; }));
-  rig.host.stop();
+  r.rig.host.stop();
   CHECK(tap.matching.load() >= 1000);
   CHECK(tap.differing.load() == 0);
   CHECK(tap.zeros.load() == 0);
@@ -121,29 +107,19 @@ TEST_CASE("hand_driver: a command written once is held unchanged, frame after fr
 // A 60 Hz writer (the model loop's rate) feeding the 1 kHz driver: ~16 driver cycles per
 // command; none of them may send a zero command once the first command arrived.
 TEST_CASE("hand_driver: a 60 Hz command writer never produces a zero command frame at 1 kHz") {
-  const std::string bus = "plug-hand-60-" + std::to_string(::getpid());
-  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
-  dr::MockCanBus dev_bus({bus, 1, 1'000'000, 5'000'000});
-  dr::testing::CommandTap<dr::hand::Command> tap(dev_bus, 1, &matches_held, &all_zero);
-  dr::sim::SimHand hand(tap, {.node = 1});
-  dr::sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
-
-  Rig rig("hand_r", "hand_driver", "hand_state");
-  rig.add("{bus: " + bus + ", node: 1, timeout_cycles: 100}");
-  auto* cmd = rig.host.ports().bind_latest_writer("hand_command", port_type_of<HandCommand>(), "test");
-  rig.host.start();
-  REQUIRE(eventually([&] { return rig.state().health == DeviceHealth::ok; }));
-  const HandCommand first = command_with(0.0f);
-  cmd->write(&first, rt::now_ns());
+  HoldRig r("plug-hand-60", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero);
+  auto& tap = r.tap;
+  r.rig.host.start();
+  REQUIRE(eventually([&] { return r.rig.state().health == DeviceHealth::ok; }));
+  r.write(command_with(0.0f));
   REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
   tap.arm();
   const auto frames_before = tap.total.load();
   for (int i = 1; i <= 60; ++i) {  // one second at 60 Hz
     std::this_thread::sleep_for(std::chrono::microseconds(16'667));
-    const HandCommand c = command_with(0.05f * std::sin(0.3f * static_cast<float>(i)));
-    cmd->write(&c, rt::now_ns());
+    r.write(command_with(0.05f * std::sin(0.3f * static_cast<float>(i))));
   }
-  rig.host.stop();
+  r.rig.host.stop();
   CHECK(tap.total.load() - frames_before > 500);
   CHECK(tap.zeros.load() == 0);
 }
