@@ -64,6 +64,7 @@ void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const W
   slot_of_node_.assign(n, -1);
   touched_.resize(n);
   shape_near_.assign(shape_count, 0);
+  springback_mm_.assign(shape_count, 0.0);
   pose_now_.resize(shape_count);
   pose_before_.resize(shape_count);
   load_.assign(shape_count, ShapeLoad{});
@@ -110,10 +111,11 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
     const WorldShape& sh = shapes[s];
     double bl[3], bh[3];
     const double t0[3] = {sh.pose0.t.x, sh.pose0.t.y, sh.pose0.t.z}, t1[3] = {sh.pose1.t.x, sh.pose1.t.y, sh.pose1.t.z};
+    const double reach_s = reach + springback_mm_[s];
     for (int a = 0; a < 3; ++a) {
       const double e0 = half_extent(sh.geom, sh.pose0, a), e1 = half_extent(sh.geom, sh.pose1, a);
-      bl[a] = std::min(t0[a] - e0, t1[a] - e1) - reach;
-      bh[a] = std::max(t0[a] + e0, t1[a] + e1) + reach;
+      bl[a] = std::min(t0[a] - e0, t1[a] - e1) - reach_s;
+      bh[a] = std::max(t0[a] + e0, t1[a] + e1) + reach_s;
     }
     if (bh[0] < lo.x || bl[0] > hi.x || bh[1] < lo.y || bl[1] > hi.y || bh[2] < lo.z || bl[2] > hi.z) continue;
     shape_near_[s] = 1;
@@ -135,7 +137,7 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
           if (p.x < bl[0] || p.x > bh[0] || p.y < bl[1] || p.y > bh[1] || p.z < bl[2] || p.z > bh[2]) continue;
           // The patch reaches up to half a diagonal of a cell from the node.
           const double patch = 0.5 * std::hypot(du_, dv_);
-          if (closest_surface(sh.geom, sh.pose1, p).distance_mm > reach + sweep + patch) continue;
+          if (closest_surface(sh.geom, sh.pose1, p).distance_mm > reach_s + sweep + patch) continue;
           int slot = slot_of_node_[node];
           if (slot < 0) {
             slot = n_touched_++;
@@ -414,7 +416,7 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
           used[s] = true;
       }
     for (int s = 0; s < t.n_shapes; ++s) {
-      if (used[s] || geo[s].pen <= -kGapMm) continue;
+      if (used[s] || geo[s].pen <= -(kGapMm + springback_mm_[t.shape[s]])) continue;
       const WorldShape& a = shapes_[t.shape[s]];
       const double ka = a.stiffness_n_per_mm3 * t.area_mm2;
       if (n_residual_ >= static_cast<int>(residual_.size())) {
@@ -433,7 +435,8 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
         // Two fingers (or a finger and the palm); a node in the crook of one finger is left to the
         // substeps (its joints do not feel it).
         const bool two = b.side == a.side && (a.finger != b.finger || a.finger < 0);
-        if (used[o] || !two || geo[o].pen <= -kGapMm || dot(geo[s].n, geo[o].n) > -0.3) continue;
+        if (used[o] || !two || geo[o].pen <= -(kGapMm + springback_mm_[t.shape[o]]) || dot(geo[s].n, geo[o].n) > -0.3)
+          continue;
         const double kb = b.stiffness_n_per_mm3 * t.area_mm2;
         r = {t.shape[s], geo[s].point, geo[s].n, t.shape[o], geo[o].point, geo[o].n, geo[s].pen + geo[o].pen,
              ka * kb / (ka + kb)};

@@ -94,6 +94,9 @@ class FingerContacts final : public sheet::SubstepContacts {
   // (not owned, fixed in size and place from now on) are the robot's.
   void configure(const sheet::SheetModel& sheet, std::span<const WorldShape> shapes, const Config& cfg);
   void set_table_friction(double mu) noexcept { cfg_.table_friction = mu; }
+  // How far shape S may spring back towards its undeflected pose in the coming steps (mm):
+  // nodes that far beyond its reach are candidates too, and listed as gaps (measure_rt). RT.
+  void set_springback(int s, double mm) noexcept { springback_mm_[s] = std::max(0.0, mm); }
 
   // Before the sheet's step of dt_s: the nodes each shape may touch in it (the shapes' pose0 ->
   // pose1). x, v: the sheet's positions and velocities. RT.
@@ -156,6 +159,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   std::vector<Touched> touched_;
   int n_touched_ = 0;
   std::vector<std::uint8_t> shape_near_;    // this step: may touch the sheet
+  std::vector<double> springback_mm_;       // per shape: set_springback
   std::vector<Pose> pose_now_, pose_before_;  // per shape, at the current substep's end and start
   std::vector<ShapeLoad> load_;
   std::vector<Residual> residual_;

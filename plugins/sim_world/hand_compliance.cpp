@@ -7,8 +7,8 @@ namespace crease::world {
 namespace {
 
 constexpr int kN = HandCompliance::kJoints;
-constexpr double kEpsNmmPerRad = 1e-6;  // keeps a joint nothing acts on at its spring's zero
-
+constexpr int kMaxRounds = 100;
+constexpr double kEpsNmmPerRad = 1e-2;  // keeps a joint nothing holds solvable (0.01 N mm per rad: nothing)
 // In-place Cholesky solve of the SPD system A x = b (A overwritten). False if not SPD.
 bool cholesky_solve(double a[kN][kN], double b[kN]) noexcept {
   for (int j = 0; j < kN; ++j) {
@@ -55,13 +55,14 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     return;
   }
   const Joints old = dq;
-  enum State : unsigned char { free_joint, saturated, locked };
+  enum State : unsigned char { free_joint, locked };
   State st[kN];
-  double sign[kN], lock_at[kN];
+  double lock_at[kN], k_eff[kN], k_full[kN], tmax[kN];
   for (int j = 0; j < kN; ++j) {
     st[j] = free_joint;
-    sign[j] = 0;
     lock_at[j] = 0;
+    k_full[j] = k_eff[j] = 1000.0 * std::max(0.0, stiffness[j]);
+    tmax[j] = 1000.0 * limits_.effort_nm[j];
   }
   bool on[kMaxContacts];
   for (int c = 0; c < nc; ++c) on[c] = contacts[c].depth_mm > 0;
@@ -73,13 +74,15 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   };
 
   Joints sol = old;
-  for (int round = 0; round < 3 * kN; ++round) {
+  rounds_ = 0;
+  failed_ = false;
+  for (int round = 0; round < kMaxRounds; ++round) {
+    ++rounds_;
     double a[kN][kN] = {};
     double r[kN];
     for (int j = 0; j < kN; ++j) {
       r[j] = tau_external[j];
-      a[j][j] = kEpsNmmPerRad + (st[j] == free_joint ? 1000.0 * std::max(0.0, stiffness[j]) : 0.0);
-      if (st[j] == saturated) r[j] -= 1000.0 * limits_.effort_nm[j] * sign[j];
+      a[j][j] = kEpsNmmPerRad + k_eff[j];
     }
     for (int c = 0; c < nc; ++c) {
       if (!on[c]) continue;
@@ -104,7 +107,10 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
       a[j][j] = 1.0;
       r[j] = lock_at[j];
     }
-    if (!cholesky_solve(a, r)) return;  // not expected: A is SPD by construction
+    if (!cholesky_solve(a, r)) {  // lost to rounding (A is SPD by construction): the last iterate
+      failed_ = true;
+      break;
+    }
     for (int j = 0; j < kN; ++j) sol[j] = r[j];
 
     bool changed = false;
@@ -115,21 +121,36 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
         changed = true;
       }
     }
+    // The torque the contacts, the external load and the spring leave on each joint at the
+    // solution: a joint at a limit stays there while it pushes into it.
+    double net[kN];
+    for (int j = 0; j < kN; ++j) net[j] = tau_external[j] - k_eff[j] * sol[j];
+    for (int c = 0; c < nc; ++c) {
+      if (!on[c]) continue;
+      const double f = contacts[c].stiffness_n_per_mm * depth(c, sol);
+      for (int j = 0; j < kN; ++j) net[j] -= f * g_[c][j];
+    }
     for (int j = 0; j < kN; ++j) {
+      if (st[j] == locked) {
+        const bool at_upper = target[j] + lock_at[j] >= limits_.upper_rad[j];
+        if (at_upper ? net[j] < 0 : net[j] > 0) {
+          st[j] = free_joint;
+          changed = true;
+        }
+        continue;
+      }
       const double q = target[j] + sol[j];
-      if (st[j] != locked && (q < limits_.lower_rad[j] || q > limits_.upper_rad[j])) {
+      if (q < limits_.lower_rad[j] || q > limits_.upper_rad[j]) {
         st[j] = locked;
         lock_at[j] = std::clamp(q, limits_.lower_rad[j], limits_.upper_rad[j]) - target[j];
         changed = true;
         continue;
       }
-      const double k = 1000.0 * std::max(0.0, stiffness[j]), tmax = 1000.0 * limits_.effort_nm[j];
-      if (st[j] == free_joint && k * std::fabs(sol[j]) > tmax) {
-        st[j] = saturated;
-        sign[j] = sol[j] > 0 ? 1.0 : -1.0;
-        changed = true;
-      } else if (st[j] == saturated && sol[j] * sign[j] * k < tmax) {
-        st[j] = free_joint;
+      // The spring saturates at the effort: its secant stiffness there, converging from above
+      // (a softening spring: each round's deflection is at most the next one's).
+      const double k = std::fabs(k_full[j] * sol[j]) <= tmax[j] ? k_full[j] : tmax[j] / std::fabs(sol[j]);
+      if (std::fabs(k - k_eff[j]) > 1e-9 * (k_full[j] + 1.0)) {
+        k_eff[j] = k;
         changed = true;
       }
     }
@@ -137,7 +158,7 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   }
   dq = sol;
   for (int j = 0; j < kN; ++j) {
-    saturated_ += st[j] == saturated;
+    saturated_ += st[j] != locked && k_eff[j] < k_full[j];
     at_limit_ += st[j] == locked;
   }
   for (int c = 0; c < nc; ++c) force_n[c] = on[c] ? contacts[c].stiffness_n_per_mm * std::max(0.0, depth(c, sol)) : 0.0;

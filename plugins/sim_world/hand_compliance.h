@@ -9,8 +9,9 @@
 // any other joint torque (held fixed). The linear system
 //   (K + sum_c k_c g_c g_c^T) dq = -sum_c k_c (d_c - g_c . dq_old) g_c + tau_external
 // is solved with an active set: contacts that would pull drop out, gaps that would close join
-// (the caller lists contacts a little apart too, depth < 0), joints whose spring torque
-// would pass the effort keep the effort, joints that would pass a limit stop at it.
+// (the caller lists contacts a little apart too, depth < 0), joints that would pass a limit
+// stop at it (and leave it when they pull away); a spring whose torque would pass the effort
+// takes its secant stiffness there, round after round (a softening spring converges so).
 // The arm is position-controlled (kinematic): its joints never deflect.
 //
 // Units: N, mm, rad; stiffness N m/rad and effort N m as the URDF (converted inside). RT after
@@ -61,11 +62,15 @@ class HandCompliance {
   // Joints that ended the last solve at their effort, or at a limit.
   [[nodiscard]] int saturated() const noexcept { return saturated_; }
   [[nodiscard]] int at_limit() const noexcept { return at_limit_; }
+  // Rounds the last solve took (at most 100), and whether its factorisation failed.
+  [[nodiscard]] int rounds() const noexcept { return rounds_; }
+  [[nodiscard]] bool failed() const noexcept { return failed_; }
 
  private:
   Limits limits_;
   std::array<Joints, kMaxContacts> g_{};  // J^T n per contact, mm/rad
-  int saturated_ = 0, at_limit_ = 0;
+  int saturated_ = 0, at_limit_ = 0, rounds_ = 0;
+  bool failed_ = false;
 };
 
 }  // namespace crease::world

@@ -16,6 +16,10 @@ void require(bool ok, const char* key, const char* why) {
   if (!ok) throw std::invalid_argument(std::string("sim_world: ") + key + ": " + why);
 }
 
+// A hand shape this far above the table still enters the balance: a finger deflected by what
+// it touched springs back up to the joint limits' reach (~30 mm at a fingertip) if that goes.
+constexpr double kTableGapMm = 50.0;
+
 bool finite_all(const World::HandJoints& a) {
   for (double v : a)
     if (!std::isfinite(v)) return false;
@@ -108,6 +112,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
   cfg.table_friction_on = params_.table_friction;
   contacts_.configure(*sheet_, shapes_, cfg);
   pose_pre_.resize(shapes_.size());
+  pose_target_.resize(shapes_.size());
   sheet_->set_substep_contacts(&contacts_);
 
   const std::size_t cap = static_cast<std::size_t>(sheet_->node_count()) * FingerContacts::kMaxShapesPerNode + shapes_.size();
@@ -187,6 +192,11 @@ void World::pose_hands_rt() noexcept {
 
 void World::step_rt() noexcept {
   for (HandSim& h : hand_) apply_commands_rt(h);
+  // Where the shapes would be at the commanded targets themselves: how far each may spring
+  // back if what holds it goes (the contacts' candidates must reach that far).
+  for (int s = 0; s < robot::kSides; ++s) kin_[s]->update_rt(hand_[s].arm, hand_[s].target);
+  for (std::size_t k = 0; k < shapes_.size(); ++k)
+    pose_target_[k] = kin_[shapes_[k].side]->compose(shapes_[k].link, shapes_[k].link_from_shape);
   // Where the new commands put the shapes with the last deflection; the hands settle there
   // against the sheet as the last step left it, and the table.
   pose_hands_rt();
@@ -201,6 +211,14 @@ void World::step_rt() noexcept {
   }
   pose_hands_rt();
   advance_shape_poses_rt(shapes_, kin_view_, false);
+  for (std::size_t k = 0; k < shapes_.size(); ++k) {
+    const WorldShape& sh = shapes_[k];
+    double extent = 0;
+    for (int a = 0; a < 3; ++a) extent = std::max(extent, half_extent(sh.geom, sh.pose1, a));
+    double c = 0;  // |rotation between the two poses| ~ 2 sin(angle / 2) from the columns
+    for (int a = 0; a < 3; ++a) c = std::max(c, sheet::norm(sh.pose1.axis(a) - pose_target_[k].axis(a)));
+    contacts_.set_springback(static_cast<int>(k), sheet::norm(sh.pose1.t - pose_target_[k].t) + 1.7320508075688772 * extent * c);
+  }
 
   const auto x0 = sheet_->positions();
   std::copy(x0.begin(), x0.end(), last_good_.begin());
@@ -251,7 +269,7 @@ void World::settle_hand_rt(int side) noexcept {
     const Vec3 low = lowest_point(s.geom, pose_pre_[k]);
     if (!over_table(low)) continue;
     const double depth = params_.table_height_mm - low.z;
-    if (depth <= -3.0) continue;  // a gap about to close counts too (hand_compliance.h)
+    if (depth <= -kTableGapMm) continue;  // a gap that may close counts too (hand_compliance.h)
     contacts[n] = {s.link, low, {0, 0, -1}, depth, s.stiffness_n_per_mm3 * params_.table_contact_area_mm2, -1, {}, {}};
     shape_of[n] = k;
     shape2_of[n++] = -1;
@@ -272,6 +290,25 @@ void World::settle_hand_rt(int side) noexcept {
     }
   }
   n_settled_[side] = n;
+}
+
+double World::geometric_penetration_mm() const noexcept {
+  double worst = 0;
+  const double h = 0.5 * sheet_->params().grid.thickness_mm;
+  const auto x = sheet_->positions();
+  for (const WorldShape& s : shapes_) {
+    if (!s.compliant) continue;
+    const Vec3 low = lowest_point(s.geom, s.pose1);
+    if (over_table(low)) worst = std::max(worst, params_.table_height_mm - low.z);
+    double e[3];
+    for (int a = 0; a < 3; ++a) e[a] = half_extent(s.geom, s.pose1, a) + h;
+    for (const Vec3& p : x) {
+      if (std::fabs(p.x - s.pose1.t.x) > e[0] || std::fabs(p.y - s.pose1.t.y) > e[1] || std::fabs(p.z - s.pose1.t.z) > e[2])
+        continue;
+      worst = std::max(worst, h - closest_surface(s.geom, s.pose1, p).distance_mm);
+    }
+  }
+  return worst;
 }
 
 bool World::over_table(Vec3 p) const noexcept {

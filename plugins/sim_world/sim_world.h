@@ -75,9 +75,14 @@ class World {
   [[nodiscard]] const HandJoints& hand_targets(Side s) const noexcept { return hand_[index(s)].target; }
   [[nodiscard]] const HandJoints& hand_angles(Side s) const noexcept { return hand_[index(s)].angles; }
   [[nodiscard]] const HandJoints& hand_deflection(Side s) const noexcept { return hand_[index(s)].deflection; }
+  [[nodiscard]] const HandJoints& hand_stiffness(Side s) const noexcept { return hand_[index(s)].stiffness; }
   // Worst depth (mm) of any hand shape in the sheet (beyond the covers' surface, i.e. into
-  // the sheet's half thickness) or below the table, at the end of the last step.
+  // the sheet's half thickness) or below the table, at the end of the last step, as the
+  // contacts measured it.
   [[nodiscard]] double max_penetration_mm() const noexcept { return max_penetration_mm_; }
+  // The same from the geometry alone, whether the contacts are on or not: every shape of the
+  // hands against every node (half the thickness from its centre) and the table top (tests).
+  [[nodiscard]] double geometric_penetration_mm() const noexcept;
   // The contacts side S settled against this step (hand_compliance.h), the shape of each (and
   // the second shape of a pinch, else -1), and each one's normal force (N).
   struct Settled {
@@ -127,7 +132,8 @@ class World {
   std::array<std::unique_ptr<SideKinematics>, robot::kSides> kin_;
   std::array<const SideKinematics*, robot::kSides> kin_view_{};
   std::vector<WorldShape> shapes_;
-  std::vector<Pose> pose_pre_;  // per shape: where the new commands put it with the last deflection
+  std::vector<Pose> pose_pre_;     // per shape: where the new commands put it with the last deflection
+  std::vector<Pose> pose_target_;  // per shape: where the commanded targets alone put it
   FingerContacts contacts_;
   std::array<HandSim, robot::kSides> hand_;
   std::array<std::unique_ptr<HandCompliance>, robot::kSides> compliance_;
