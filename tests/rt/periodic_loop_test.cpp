@@ -66,8 +66,9 @@ TEST_CASE("an overrun skips the missed periods instead of replaying them") {
   const auto& t = loop.timing();
   CHECK(t.overruns.load() >= 1);
   CHECK(t.missed_periods.load() >= 24);
-  // The 25 ms body caused an overrun of its own: not all overruns are late wake-ups.
-  CHECK(t.late_wakes.load() < t.overruns.load());
+  // Late wake-ups are counted among the overruns, never beside them. (Whether the long
+  // cycle's own overrun counts as late depends on when a loaded machine woke it.)
+  CHECK(t.late_wakes.load() <= t.overruns.load());
   // The cycle after the long one is numbered past the skipped deadlines: no burst replays them.
   const std::uint64_t busy = rec.busy_cycle.load();
   std::size_t i = 0;

@@ -147,11 +147,13 @@ TEST_CASE("QoS from the configuration: a reliable subscriber refuses a best-effo
   REQUIRE(eventually([&] { return b.read("keypoints", *kp).has_data() && kp->count == 4; }));
   REQUIRE(eventually([&] { return b.stats("bridge").topics[0].incompatible_qos > 0; }));
   REQUIRE(eventually([&] { return a.stats("bridge").topics[0].incompatible_qos > 0; }));
+  // The compatible topic is fresh again once its next sample arrived (a loaded machine may
+  // delay one past its deadline): wait for that rather than expect it at one instant.
+  REQUIRE(eventually([&] { return b.stats("bridge").topics[1].stale == 0; }));
   const BridgeStats st = b.stats("bridge");
   CHECK(st.topics[0].samples == 0);
   CHECK(st.topics[0].port_writes == 0);
   CHECK(st.topics[0].stale == 1);
-  CHECK(st.topics[1].stale == 0);
   CHECK(st.topics[1].incompatible_qos == 0);
   HandState s;
   CHECK_FALSE(b.read("hand_state", s).has_data());
