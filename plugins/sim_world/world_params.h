@@ -23,9 +23,9 @@ namespace crease::world {
   p.grid.origin_mm = {-105.0, 148.5, 0.5 * p.grid.thickness_mm};
   p.solver.substeps = 2;                 // per world step: 0.5 ms
   p.solver.max_speed_mm_per_s = 5000.0;  // above the arms' fastest motion (~3 m/s at the hand)
-  p.solver.yield_strain = 0.05;          // see README.md: bends tighter than ~20 mm over 22 mm yield
+  p.solver.yield_strain = 0.05;          // a first choice (README.md): bends tighter than ~20 mm over 22 mm yield
   p.solver.plasticity_rate = 0.3;
-  p.solver.plasticity_every = 10;        // every 5 ms
+  p.solver.plasticity_every = 20;        // every 10 ms
   return p;
 }
 
