@@ -48,6 +48,16 @@ struct TappedDriverRig {
     command = rig.host.ports().bind_latest_writer(command_port, port_type_of<PortCommand>(), "test");
   }
   void write(const PortCommand& c) { command->write(&c, rt::now_ns()); }
+  // Starts the loop, waits until ready(driver state) holds, writes `first`, waits until the
+  // device received it, then arms the tap (frames from here on are counted).
+  template <class Ready>
+  void start_with(Ready ready, const PortCommand& first) {
+    rig.host.start();
+    REQUIRE(eventually([&] { return ready(rig.state()); }));
+    write(first);
+    REQUIRE(eventually([&] { return tap.matching.load() > 0; }));  // the command reached the device
+    tap.arm();
+  }
 
   std::string bus;
   drivers::MockCanBroker broker;

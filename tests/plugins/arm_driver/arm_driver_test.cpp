@@ -77,6 +77,7 @@ ArmCommand command_with(float offset) {
 }
 using HoldRig = test::TappedDriverRig<dr::sim::SimArm, dr::sim::SimArmConfig, dr::arm::Command, ArmCommand, ArmState>;
 using test::eventually;
+bool drive_enabled(const ArmState& s) { return s.drive_state == 4; }  // cia402 operation enabled
 }  // namespace
 
 // As for the hand: seen on the device side, a set point written once is the set point of every
@@ -84,11 +85,7 @@ using test::eventually;
 TEST_CASE("arm_driver: a set point written once is held unchanged, frame after frame, for 1000 cycles") {
   HoldRig r("plug-arm-hold", 10, "arm_r", "arm_driver", "arm_state", "arm_command", &matches_held, &all_zero);
   auto& tap = r.tap;
-  r.rig.host.start();
-  REQUIRE(eventually([&] { return r.rig.state().drive_state == 4; }));  // operation enabled
-  r.write(command_with(0.0f));
-  REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
-  tap.arm();
+  r.start_with(&drive_enabled, command_with(0.0f));
   const auto start = tap.total.load();
   REQUIRE(eventually([&] { return tap.total.load() >= start + 1000; }));
   r.rig.host.stop();
@@ -100,11 +97,7 @@ TEST_CASE("arm_driver: a set point written once is held unchanged, frame after f
 TEST_CASE("arm_driver: a 60 Hz set-point writer never produces a zero set point at 1 kHz") {
   HoldRig r("plug-arm-60", 10, "arm_r", "arm_driver", "arm_state", "arm_command", &matches_held, &all_zero);
   auto& tap = r.tap;
-  r.rig.host.start();
-  REQUIRE(eventually([&] { return r.rig.state().drive_state == 4; }));  // operation enabled
-  r.write(command_with(0.0f));
-  REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
-  tap.arm();
+  r.start_with(&drive_enabled, command_with(0.0f));
   const auto frames_before = tap.total.load();
   for (int i = 1; i <= 60; ++i) {
     std::this_thread::sleep_for(std::chrono::microseconds(16'667));

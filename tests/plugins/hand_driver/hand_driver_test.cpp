@@ -83,6 +83,7 @@ HandCommand command_with(float offset) {
 }
 using HoldRig = test::TappedDriverRig<dr::sim::SimHand, dr::sim::SimHandConfig, dr::hand::Command, HandCommand, HandState>;
 using test::eventually;
+bool link_ok(const HandState& s) { return s.health == DeviceHealth::ok; }
 }  // namespace
 
 // The device side sees every command frame: a command written once must be the command of
@@ -91,11 +92,7 @@ using test::eventually;
 TEST_CASE("hand_driver: a command written once is held unchanged, frame after frame, for 1000 cycles") {
   HoldRig r("plug-hand-hold", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero);
   auto& tap = r.tap;
-  r.rig.host.start();
-  REQUIRE(eventually([&] { return r.rig.state().health == DeviceHealth::ok; }));
-  r.write(command_with(0.0f));
-  REQUIRE(eventually([&] { return tap.matching.load() > 0; }));  // the command reached the device
-  tap.arm();
+  r.start_with(&link_ok, command_with(0.0f));
   const auto start = tap.total.load();
   REQUIRE(eventually([&] { return tap.total.load() >= start + 1000; }));
   r.rig.host.stop();
@@ -109,11 +106,7 @@ TEST_CASE("hand_driver: a command written once is held unchanged, frame after fr
 TEST_CASE("hand_driver: a 60 Hz command writer never produces a zero command frame at 1 kHz") {
   HoldRig r("plug-hand-60", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero);
   auto& tap = r.tap;
-  r.rig.host.start();
-  REQUIRE(eventually([&] { return r.rig.state().health == DeviceHealth::ok; }));
-  r.write(command_with(0.0f));
-  REQUIRE(eventually([&] { return tap.matching.load() > 0; }));
-  tap.arm();
+  r.start_with(&link_ok, command_with(0.0f));
   const auto frames_before = tap.total.load();
   for (int i = 1; i <= 60; ++i) {  // one second at 60 Hz
     std::this_thread::sleep_for(std::chrono::microseconds(16'667));
