@@ -95,8 +95,9 @@ void Loop::adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept {
   adopted_.store(next->generation, std::memory_order_release);
 }
 
-std::int64_t Loop::run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle) noexcept {
-  const std::int64_t t0 = rt::now_ns();
+std::int64_t Loop::run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle,
+                               std::int64_t& t0) noexcept {
+  t0 = rt::now_ns();
   Status status = Status::ok;
   const FaultKind fault = write_phase ? inst.write_rt(cycle, status) : inst.update_rt(cycle, status);
   const std::int64_t t1 = rt::now_ns();
@@ -129,8 +130,8 @@ void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
     const RunState st = inst.state.load(std::memory_order_acquire);
     if (st == RunState::active) {
       inst.apply_param_changes_rt();
-      const std::int64_t t0 = rt::now_ns();
-      const std::int64_t ns = run_hook_rt(inst, false, cycle);
+      std::int64_t t0 = 0;
+      const std::int64_t ns = run_hook_rt(inst, false, cycle, t0);
       // An instance with a write phase is timed over both hooks (recorded after its write).
       if (inst.has_write() && inst.state.load(std::memory_order_relaxed) == RunState::active) {
         e.update_ns = ns;
@@ -149,8 +150,9 @@ void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
   for (const Schedule::Entry& e : s->entries) {
     if (e.update_ns < 0) continue;
     PluginInstance& inst = *e.instance;
-    const std::int64_t t0 = rt::now_ns();
-    record_execution_rt(inst, e.update_ns + run_hook_rt(inst, true, cycle), clock.cycle, t0);
+    std::int64_t t0 = 0;
+    const std::int64_t ns = run_hook_rt(inst, true, cycle, t0);
+    record_execution_rt(inst, e.update_ns + ns, clock.cycle, t0);
   }
 }
 

@@ -109,8 +109,8 @@ class Loop {
   void adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept;
   void push_event_rt(const LoopEvent& e) noexcept { (void)events_.try_push(&e); }
   // Runs one phase's hook of an active instance and accounts for it: degraded and fault counts,
-  // the firewall event. Returns the hook's duration (ns).
-  std::int64_t run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle) noexcept;
+  // the firewall event. Returns the hook's duration (ns); t0: when it started.
+  std::int64_t run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle, std::int64_t& t0) noexcept;
   static void record_execution_rt(PluginInstance& inst, std::int64_t ns, std::uint64_t cycle, std::int64_t t0) noexcept;
 
   LoopSpec spec_;

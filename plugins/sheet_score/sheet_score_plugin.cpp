@@ -41,8 +41,7 @@ class SheetScore final : public Plugin {
     }
     model_ = ports.latest_input<SheetState>("sheet_state");
     truth_ = ports.latest_input<SheetState>("sheet_truth");
-    Figure safe = figure_;  // named, no samples
-    out_ = ports.latest_output<Figure>("tracking_error", safe);
+    out_ = ports.latest_output<Figure>("tracking_error", figure_);  // safe value: named, no samples
   }
 
   Status update(const Cycle& cycle) override {
