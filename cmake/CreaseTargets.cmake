@@ -3,19 +3,23 @@
 find_package(doctest REQUIRED)
 find_package(Threads REQUIRED)
 
-# crease_plugin(NAME SOURCES... [LIBS ...])
-# A dlopen'able MODULE with hidden visibility, built with -fno-gnu-unique so dlclose
-# really unloads it. Output: ${CREASE_PLUGIN_DIR}/lib<NAME>.so
+include(CreasePluginFlags)
+
+# crease_plugin(NAME SOURCES... [LIBS ...] [NO_INSTALL])
+# A dlopen'able MODULE with the plugin flags of CreasePluginFlags.cmake. Output:
+# ${CREASE_PLUGIN_DIR}/lib<NAME>.so; installed into lib/crease/plugins unless NO_INSTALL (the
+# framework's own test plugins), with a run path to the installed lib/.
 function(crease_plugin name)
-  cmake_parse_arguments(P "" "" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(P "NO_INSTALL" "" "SOURCES;LIBS" ${ARGN})
   add_library(${name} MODULE ${P_SOURCES})
   target_link_libraries(${name} PRIVATE crease_core crease_options ${P_LIBS})
+  crease_plugin_flags(${name})
   set_target_properties(${name} PROPERTIES
-    CXX_VISIBILITY_PRESET hidden
-    VISIBILITY_INLINES_HIDDEN ON
-    LIBRARY_OUTPUT_DIRECTORY ${CREASE_PLUGIN_DIR})
-  target_compile_options(${name} PRIVATE -fno-gnu-unique)
-  target_link_options(${name} PRIVATE -Wl,--no-undefined)
+    LIBRARY_OUTPUT_DIRECTORY ${CREASE_PLUGIN_DIR}
+    INSTALL_RPATH "$ORIGIN/../..")
+  if(NOT P_NO_INSTALL)
+    install(TARGETS ${name} LIBRARY DESTINATION ${CREASE_INSTALL_PLUGINDIR} COMPONENT runtime)
+  endif()
   set_property(GLOBAL APPEND PROPERTY CREASE_ALL_PLUGINS ${name})
 endfunction()
 
