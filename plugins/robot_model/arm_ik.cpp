@@ -1,0 +1,169 @@
+#include "plugins/robot_model/arm_ik.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/errors.h"
+
+namespace crease::robot {
+
+namespace {
+using Mat67 = Eigen::Matrix<double, 6, kArmJoints>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Vec7 = Eigen::Matrix<double, kArmJoints, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+}  // namespace
+
+ArmIk::ArmIk(const RobotModel& model, Side side, const Options& options) : opt_(options) {
+  const std::string prefix = model.params().side(side).prefix;
+  flange_chain_ = std::make_unique<ToolChain>(model.make_chain(side, prefix + "flange"));
+  chain_ = std::make_unique<KDL::Chain>(flange_chain_->chain());
+  if (chain_->getNrOfJoints() != static_cast<unsigned>(kArmJoints)) {
+    throw ConfigError(model.urdf_file() + ": the world -> " + prefix + "flange chain must hold the arm's 7 joints");
+  }
+  const auto& sources = flange_chain_->sources();
+  for (int j = 0; j < kArmJoints; ++j) {
+    if (sources[j].kind != JointSource::arm || sources[j].index != j || sources[j].multiplier != 1.0 ||
+        sources[j].offset != 0.0) {
+      throw ConfigError(model.urdf_file() + ": the arm's chain must hold S1..W2 in order");
+    }
+  }
+  fk_ = std::make_unique<KDL::ChainFkSolverPos_recursive>(*chain_);
+  jac_ = std::make_unique<KDL::ChainJntToJacSolver>(*chain_);
+  q_.resize(kArmJoints);
+  j_.resize(kArmJoints);
+  tools_.reserve(kToolFrames);
+  for (int f = 0; f < kToolFrames; ++f) {
+    tools_.push_back(model.make_chain(side, prefix + std::string(kToolFrameLinks[f])));
+  }
+  const auto& joints = model.arm_joints(side);
+  for (int j = 0; j < kArmJoints; ++j) {
+    lo_[j] = joints[j].lower_rad;
+    hi_[j] = joints[j].upper_rad;
+    vmax_[j] = joints[j].velocity_rad_s;
+    if (!(opt_.rest_rad[j] >= lo_[j] && opt_.rest_rad[j] <= hi_[j])) {
+      throw ConfigError("rest posture: joint " + joints[j].name + " outside its limits");
+    }
+  }
+}
+
+bool ArmIk::set_tool(ToolFrame tool, std::span<const double, kArmJoints> arm, HandAngles hand) noexcept {
+  KDL::Frame world_flange, world_tool;
+  if (!flange_chain_->pose_m(arm, hand, world_flange)) return false;
+  if (!tools_[static_cast<int>(tool)].pose_m(arm, hand, world_tool)) return false;
+  set_tool_offset(tool, world_flange.Inverse() * world_tool);
+  return true;
+}
+
+KDL::Frame ArmIk::tool_pose(std::span<const double, kArmJoints> q) noexcept {
+  for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
+  if (fk_->JntToCart(q_, f_) < 0) return KDL::Frame::Identity();
+  return f_ * flange_tool_;
+}
+
+void ArmIk::random_seed(std::span<double, kArmJoints> q) noexcept {
+  for (int j = 0; j < kArmJoints; ++j) {
+    rng_ ^= rng_ << 13;  // xorshift64
+    rng_ ^= rng_ >> 7;
+    rng_ ^= rng_ << 17;
+    const double u = static_cast<double>(rng_ >> 11) * (1.0 / 9007199254740992.0);
+    // Within the middle 80 % of each range: seeds at a limit start locked.
+    q[j] = lo_[j] + (0.1 + 0.8 * u) * (hi_[j] - lo_[j]);
+  }
+}
+
+bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, bool null_space_first, Result& r) noexcept {
+  bool null_pending = null_space_first && opt_.rest_gain > 0;
+  bool locked[kArmJoints] = {};
+  for (int it = 0;; ++it) {
+    if (fk_->JntToCart(q_, f_) < 0) return false;
+    const KDL::Frame tool = f_ * flange_tool_;
+    const KDL::Twist err = KDL::diff(tool, target);  // vel: position error, rot: world axis-angle
+    r.error_m = err.vel.Norm();
+    r.error_rad = err.rot.Norm();
+    const bool converged = r.error_m < opt_.tolerance_m && r.error_rad < opt_.tolerance_rad;
+    if ((converged && !null_pending) || it >= max_iterations) return converged;
+
+    if (jac_->JntToJac(q_, j_) < 0) return false;
+    j_.changeRefPoint(f_.M * flange_tool_.p);  // the tool frame's origin
+    Mat67 J = j_.data;
+    Vec6 e;
+    e << err.vel.x(), err.vel.y(), err.vel.z(), err.rot.x(), err.rot.y(), err.rot.z();
+    // A locked joint comes free when the error pulls it back inside its range.
+    const Vec7 g = J.transpose() * e;
+    for (int j = 0; j < kArmJoints; ++j) {
+      if (locked[j] && ((q_(j) <= lo_[j] && g(j) > 0) || (q_(j) >= hi_[j] && g(j) < 0))) locked[j] = false;
+      if (locked[j]) J.col(j).setZero();
+    }
+    const double e2 = e.squaredNorm();
+    const double lambda2 = opt_.lambda0 * opt_.lambda0 + opt_.lambda_per_error * opt_.lambda_per_error * e2;
+    const Mat6 A = J * J.transpose() + lambda2 * Mat6::Identity();
+    const Eigen::LDLT<Mat6> ldlt(A);
+    Vec7 dq = J.transpose() * ldlt.solve(e);
+    if (null_pending) {
+      Vec7 z;
+      for (int j = 0; j < kArmJoints; ++j) z(j) = locked[j] ? 0.0 : opt_.rest_gain * (opt_.rest_rad[j] - q_(j));
+      dq += z - J.transpose() * ldlt.solve(J * z);  // (I - J^+ J) z
+      null_pending = false;
+    }
+    const double biggest = dq.cwiseAbs().maxCoeff();
+    if (biggest > opt_.max_step_rad) dq *= opt_.max_step_rad / biggest;
+    for (int j = 0; j < kArmJoints; ++j) {
+      double v = q_(j) + dq(j);
+      if (opt_.respect_limits) {
+        if (v <= lo_[j]) {
+          v = lo_[j];
+          locked[j] = true;
+        } else if (v >= hi_[j]) {
+          v = hi_[j];
+          locked[j] = true;
+        }
+      }
+      q_(j) = v;
+    }
+    ++r.iterations;
+  }
+}
+
+ArmIk::Result ArmIk::solve(const KDL::Frame& target, std::span<const double, kArmJoints> seed,
+                           std::span<double, kArmJoints> q) noexcept {
+  Result r, attempt;
+  double best = INFINITY;
+  Joints start{}, best_q{};
+  for (int j = 0; j < kArmJoints; ++j) start[j] = opt_.respect_limits ? std::clamp(seed[j], lo_[j], hi_[j]) : seed[j];
+  for (int a = 0; a <= opt_.restarts; ++a) {
+    if (a > 0) random_seed(start);
+    for (int j = 0; j < kArmJoints; ++j) q_(j) = start[j];
+    attempt = Result{};
+    const bool ok = iterate(target, opt_.max_iterations, a == 0, attempt);
+    r.iterations += attempt.iterations;
+    r.attempts = a + 1;
+    // Best: converged first, then the smaller error (1 mm counts as 1 mrad).
+    const double score = (ok ? 0.0 : 1e6) + attempt.error_m + attempt.error_rad;
+    if (score < best) {
+      best = score;
+      r.converged = ok;
+      r.error_m = attempt.error_m;
+      r.error_rad = attempt.error_rad;
+      for (int j = 0; j < kArmJoints; ++j) best_q[j] = q_(j);
+    }
+    if (ok) break;
+  }
+  for (int j = 0; j < kArmJoints; ++j) q[j] = best_q[j];
+  return r;
+}
+
+ArmIk::Result ArmIk::track(const KDL::Frame& target, std::span<double, kArmJoints> q) noexcept {
+  Result r;
+  for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
+  r.attempts = 1;
+  r.converged = iterate(target, opt_.track_iterations, true, r);
+  for (int j = 0; j < kArmJoints; ++j) q[j] = q_(j);
+  return r;
+}
+
+}  // namespace crease::robot
