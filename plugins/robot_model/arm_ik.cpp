@@ -76,8 +76,8 @@ void ArmIk::random_seed(std::span<double, kArmJoints> q) noexcept {
   }
 }
 
-bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, bool null_space_first, Result& r) noexcept {
-  bool null_pending = null_space_first && opt_.rest_gain > 0;
+bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_gain, Result& r) noexcept {
+  bool null_pending = rest_gain > 0;
   bool locked[kArmJoints] = {};
   for (int it = 0;; ++it) {
     if (fk_->JntToCart(q_, f_) < 0) return false;
@@ -106,7 +106,7 @@ bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, bool null_spac
     Vec7 dq = J.transpose() * ldlt.solve(e);
     if (null_pending) {
       Vec7 z;
-      for (int j = 0; j < kArmJoints; ++j) z(j) = locked[j] ? 0.0 : opt_.rest_gain * (opt_.rest_rad[j] - q_(j));
+      for (int j = 0; j < kArmJoints; ++j) z(j) = locked[j] ? 0.0 : rest_gain * (opt_.rest_rad[j] - q_(j));
       dq += z - J.transpose() * ldlt.solve(J * z);  // (I - J^+ J) z
       null_pending = false;
     }
@@ -139,7 +139,7 @@ ArmIk::Result ArmIk::solve(const KDL::Frame& target, std::span<const double, kAr
     if (a > 0) random_seed(start);
     for (int j = 0; j < kArmJoints; ++j) q_(j) = start[j];
     attempt = Result{};
-    const bool ok = iterate(target, opt_.max_iterations, a == 0, attempt);
+    const bool ok = iterate(target, opt_.max_iterations, a == 0 ? opt_.rest_gain : 0.0, attempt);
     r.iterations += attempt.iterations;
     r.attempts = a + 1;
     // Best: converged first, then the smaller error (1 mm counts as 1 mrad).
@@ -161,7 +161,7 @@ ArmIk::Result ArmIk::track(const KDL::Frame& target, std::span<double, kArmJoint
   Result r;
   for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
   r.attempts = 1;
-  r.converged = iterate(target, opt_.track_iterations, true, r);
+  r.converged = iterate(target, opt_.track_iterations, opt_.track_rest_gain, r);
   for (int j = 0; j < kArmJoints; ++j) q[j] = q_(j);
   return r;
 }

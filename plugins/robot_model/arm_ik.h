@@ -16,7 +16,8 @@
 // squares, Levenberg-Marquardt style: robust far from the target, quadratic near it, bounded at
 // singularities); the second term is the stated redundancy resolution: in the Jacobian's null
 // space, towards a rest posture (by default elbow bent, wrist bent: the posture the arms work
-// over the table in), applied once per call so it moves the elbow slowly and never the tool.
+// over the table in), applied once per call (k = rest_gain in solve, track_rest_gain in track)
+// so it moves the elbow slowly and never the tool.
 // Joint limits: each step is clamped to [lower, upper] (the URDF's), and a joint that reached
 // a limit is locked (its Jacobian column zeroed) for the rest of the call, so the others
 // complete the task; every returned q lies within the limits. solve() restarts from
@@ -57,7 +58,8 @@ class ArmIk {
     double lambda0 = 1e-3;          // damping floor (m-equivalent): bounds steps at singularities
     double lambda_per_error = 0.5;  // lambda^2 += (this * |e|)^2
     double max_step_rad = 0.3;      // per iteration, per joint
-    double rest_gain = 0.02;        // fraction of (q_rest - q) per call, in the null space
+    double rest_gain = 0.02;        // fraction of (q_rest - q) per solve() attempt, in the null space
+    double track_rest_gain = 5e-4;  // the same per track() call: at 1 kHz, 0.5 rad/s per rad away
     Joints rest_rad = {0.0, 0.5, 0.0, 1.4, 0.0, 1.2, 0.0};  // elbow and wrist bent
     bool respect_limits = true;     // false only to show in tests what the limits change
   };
@@ -108,7 +110,7 @@ class ArmIk {
 
  private:
   // Iterations from q_ (in place); returns whether converged. ITERATIONS counted in R.
-  bool iterate(const KDL::Frame& flange_target, int max_iterations, bool null_space_first, Result& r) noexcept;
+  bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, Result& r) noexcept;
   void error_of(const KDL::Frame& flange_target, double& e_m, double& e_rad) noexcept;
   void random_seed(std::span<double, kArmJoints> q) noexcept;
 

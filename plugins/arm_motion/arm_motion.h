@@ -1,0 +1,139 @@
+// One arm's Cartesian motion controller: goals in, a joint command and a status out, once per
+// control cycle. The arm_motion plugin wraps it (ports); tests and crease-bench drive it
+// directly.
+//
+//   ArmMotion m(model, Side::right, params);        // configure time: allocates, may throw
+//   m.on_goal(goal, in, world_sheet_or_null);         // RT: a goal popped this cycle
+//   if (m.step(in)) write(m.command());               // RT: every cycle
+//   publish(m.status());
+//
+// A goal is refused on arrival (counted per reason, nothing moves) when its content fails
+// goal_check.h, a motion is already active (busy), the arm is not ready, a hand tool frame has
+// no fresh hand_state, a stop condition has no fresh armed contact_state, a sheet-frame goal
+// has no sheet, or a point lies outside the workspace. An accepted goal's path (from the
+// tool frame's commanded pose through its points) is then solved ahead, check_step_mm apart,
+// check_samples_per_cycle samples per cycle, while the command stays held: a sample without an
+// IK solution inside the joint limits refuses it as unreachable, a sample needing a joint
+// faster than joint_speed_fraction of its URDF limit as joint_speed. Only then does it run:
+// each cycle the path profile steps (cartesian_path.h) and the IK tracks the new pose warm
+// from the last command (ArmIk::track); the command's velocity is the step over the cycle.
+//
+// Stop condition (contact_onset): checked every running cycle before the profile steps, so a
+// fired condition starts the deceleration (at the goal's stop_accel) in the same cycle; at rest
+// the state is stopped_on_contact. A stale or unhealthy contact_state while armed decelerates
+// the same way and ends aborted (contact_stale). A stale or faulted arm_state aborts at once
+// and holds the last command (the drive is not following: the driver commands its own safe
+// state); when the arm is ready again the held command is re-seated at the measured angles,
+// so the drive is never sent back to where it was before the fault.
+// Holding: with nothing running the command is the last one, unchanged, every cycle.
+// The whole state is plain data (save_state / load_state: a motion carried across a hot-swap).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "core/port_types/arm.h"
+#include "core/port_types/arm_goal.h"
+#include "core/port_types/contact.h"
+#include "core/port_types/hand.h"
+#include "plugins/arm_motion/cartesian_path.h"
+#include "plugins/arm_motion/goal_check.h"
+#include "plugins/robot_model/arm_ik.h"
+
+namespace crease::arm_motion {
+
+struct MotionParams {
+  GoalLimits limits;
+  Workspace workspace;
+  double arm_state_max_age_s = 0.005;      // arm_state's status older than this: stale
+  double hand_state_max_age_s = 0.02;
+  double contact_state_max_age_s = 0.005;
+  double sheet_state_max_age_s = 0.2;      // (the plugin checks it)
+  int check_samples_per_cycle = 2;
+  double check_step_mm = 5.0;
+  double check_step_rad = 0.05;
+  double joint_speed_fraction = 0.9;       // of the URDF's velocity limits
+  double tracking_tolerance_mm = 0.01;     // the IK residual a running cycle accepts
+  double tracking_tolerance_rad = 1e-5;
+  robot::ArmIk::Options ik;
+};
+
+// One cycle's inputs; null pointers for ports never written. Stamps: the payloads' own
+// timestamp_ns fields (reception or computation times), compared with now_ns.
+struct CycleInputs {
+  std::int64_t now_ns = 0;
+  double dt_s = 0.001;
+  const ArmState* arm = nullptr;
+  const HandState* hand = nullptr;
+  const ContactState* contact = nullptr;
+};
+
+// Everything a motion is, as plain bytes (what a hot-swap carries).
+struct MotionState {
+  static constexpr std::uint32_t kMagic = 0x314d5241;  // "ARM1"
+  std::uint32_t magic = kMagic;
+  std::uint32_t size = 0;
+  double q_cmd[robot::kArmJoints] = {};
+  double v_cmd[robot::kArmJoints] = {};
+  std::uint8_t have_cmd = 0;
+  std::uint8_t arm_was_ready = 0;
+  std::uint8_t phase = ArmMotionStatus::idle;
+  std::uint8_t end_state = 0;   // what a stop ends in (stopped_on_contact or aborted)
+  std::uint8_t end_reason = 0;
+  std::uint8_t tool = 0;
+  std::uint8_t stop_on = 0;
+  std::uint8_t stop_fingers = 0;
+  std::uint64_t onsets_at_start = 0;
+  double offset_p[3] = {};             // flange -> tool, metres
+  double offset_quat[4] = {0, 0, 0, 1};
+  CartesianPath path;
+  PathProfile profile;
+  int check_segment = 0;
+  double check_sigma = 0;
+  double q_check[robot::kArmJoints] = {};
+  ArmMotionStatus status;
+};
+
+class ArmMotion {
+ public:
+  // Non-RT. MODEL is read here only. Throws crease::ConfigError (the IK's rest posture).
+  ArmMotion(const robot::RobotModel& model, robot::Side side, const MotionParams& params);
+
+  // RT. A goal popped this cycle (before step). WORLD_SHEET: the sheet frame (metres) when the
+  // goal is in the sheet frame and a fresh sheet_state gave one, else null.
+  void on_goal(const ArmGoal& goal, const CycleInputs& in, const KDL::Frame* world_sheet) noexcept;
+  // RT. One cycle. True when command() is to be written (from the first ready arm_state on).
+  bool step(const CycleInputs& in) noexcept;
+
+  [[nodiscard]] const ArmCommand& command() const noexcept { return command_; }
+  [[nodiscard]] const ArmMotionStatus& status() const noexcept { return s_.status; }
+  [[nodiscard]] const MotionState& state() const noexcept { return s_; }
+  [[nodiscard]] robot::ArmIk& ik() noexcept { return ik_; }
+
+  // RT-safe. Bytes written, or SIZE_MAX when OUT is too small.
+  std::size_t save_state(std::span<std::byte> out) const noexcept;
+  // RT-safe. False (and nothing changed) for bytes that are not a MotionState of this build.
+  bool load_state(std::span<const std::byte> in) noexcept;
+
+ private:
+  enum class Readiness : std::uint8_t { ready, stale, fault };
+  [[nodiscard]] Readiness arm_readiness(const CycleInputs& in) const noexcept;
+  [[nodiscard]] bool contact_fresh(const CycleInputs& in) const noexcept;
+  void refuse(std::uint32_t id, ArmMotionReason r) noexcept;
+  void finish(ArmMotionStatus::State st, ArmMotionReason r) noexcept;
+  void begin_stop(ArmMotionStatus::State end, ArmMotionReason r) noexcept;
+  void check_path(const CycleInputs& in) noexcept;
+  void run(const CycleInputs& in) noexcept;
+  void publish(const CycleInputs& in) noexcept;
+
+  MotionParams p_;
+  robot::ArmIk ik_;
+  MotionState s_;
+  ArmCommand command_;
+  double ik_error_m_ = 0;
+  double speed_m_s_ = 0;
+};
+
+}  // namespace crease::arm_motion

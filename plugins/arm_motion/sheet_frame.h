@@ -1,0 +1,18 @@
+// The sheet frame a goal's points may be given in (ArmGoal::sheet), from a sheet_state: origin at
+// node (0, 0) (u = v = 0), x towards node (W-1, 0) (along u), z = x cross (node (0, H-1) - origin)
+// (DESIGN's z = u x v: into the paper, away from the printed face), y = z cross x. A rigid frame
+// of the sheet's corner edges: what a fold's points are relative to when the motion starts.
+// RT: reads three nodes.
+#pragma once
+
+#include <kdl/frames.hpp>
+
+#include "core/port_types/sheet_state.h"
+
+namespace crease::arm_motion {
+
+// World <- sheet, metres. False for a state with fewer than 2 x 2 nodes, non-finite corner
+// nodes or degenerate (coincident or collinear) edges.
+[[nodiscard]] bool sheet_frame_m(const SheetState& s, KDL::Frame& world_sheet) noexcept;
+
+}  // namespace crease::arm_motion
