@@ -164,7 +164,8 @@ void ArmMotion::check_path(const CycleInputs& in) noexcept {
     double dsig = 1.0;
     if (len > 0) dsig = std::min(dsig, p_.check_step_mm * 1e-3 / len);
     if (ang > 0) dsig = std::min(dsig, p_.check_step_rad / ang);
-    const double sig = std::min(1.0, s_.check_sigma + dsig);
+    double sig = s_.check_sigma + dsig;
+    if (sig > 1.0 - 1e-9) sig = 1.0;  // no sliver of a step left at a segment's end
     const KDL::Frame target = pose_at(path, k, sig);
     double q[kArmJoints];
     std::memcpy(q, s_.q_check, sizeof(q));

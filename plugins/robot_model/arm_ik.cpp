@@ -76,7 +76,8 @@ void ArmIk::random_seed(std::span<double, kArmJoints> q) noexcept {
   }
 }
 
-bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_gain, Result& r) noexcept {
+bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step,
+                    Result& r) noexcept {
   bool null_pending = rest_gain > 0;
   bool locked[kArmJoints] = {};
   for (int it = 0;; ++it) {
@@ -106,7 +107,9 @@ bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_ga
     Vec7 dq = J.transpose() * ldlt.solve(e);
     if (null_pending) {
       Vec7 z;
-      for (int j = 0; j < kArmJoints; ++j) z(j) = locked[j] ? 0.0 : rest_gain * (opt_.rest_rad[j] - q_(j));
+      for (int j = 0; j < kArmJoints; ++j) {
+        z(j) = locked[j] ? 0.0 : std::clamp(rest_gain * (opt_.rest_rad[j] - q_(j)), -rest_max_step, rest_max_step);
+      }
       dq += z - J.transpose() * ldlt.solve(J * z);  // (I - J^+ J) z
       null_pending = false;
     }
@@ -139,7 +142,7 @@ ArmIk::Result ArmIk::solve(const KDL::Frame& target, std::span<const double, kAr
     if (a > 0) random_seed(start);
     for (int j = 0; j < kArmJoints; ++j) q_(j) = start[j];
     attempt = Result{};
-    const bool ok = iterate(target, opt_.max_iterations, a == 0 ? opt_.rest_gain : 0.0, attempt);
+    const bool ok = iterate(target, opt_.max_iterations, a == 0 ? opt_.rest_gain : 0.0, opt_.max_step_rad, attempt);
     r.iterations += attempt.iterations;
     r.attempts = a + 1;
     // Best: converged first, then the smaller error (1 mm counts as 1 mrad).
@@ -161,7 +164,7 @@ ArmIk::Result ArmIk::track(const KDL::Frame& target, std::span<double, kArmJoint
   Result r;
   for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
   r.attempts = 1;
-  r.converged = iterate(target, opt_.track_iterations, opt_.track_rest_gain, r);
+  r.converged = iterate(target, opt_.track_iterations, opt_.track_rest_gain, opt_.track_rest_max_step_rad, r);
   for (int j = 0; j < kArmJoints; ++j) q[j] = q_(j);
   return r;
 }

@@ -60,6 +60,7 @@ class ArmIk {
     double max_step_rad = 0.3;      // per iteration, per joint
     double rest_gain = 0.02;        // fraction of (q_rest - q) per solve() attempt, in the null space
     double track_rest_gain = 5e-4;  // the same per track() call: at 1 kHz, 0.5 rad/s per rad away
+    double track_rest_max_step_rad = 1e-4;  // and at most this per joint per call (0.1 rad/s at 1 kHz)
     Joints rest_rad = {0.0, 0.5, 0.0, 1.4, 0.0, 1.2, 0.0};  // elbow and wrist bent
     bool respect_limits = true;     // false only to show in tests what the limits change
   };
@@ -110,7 +111,7 @@ class ArmIk {
 
  private:
   // Iterations from q_ (in place); returns whether converged. ITERATIONS counted in R.
-  bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, Result& r) noexcept;
+  bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step, Result& r) noexcept;
   void error_of(const KDL::Frame& flange_target, double& e_m, double& e_rad) noexcept;
   void random_seed(std::span<double, kArmJoints> q) noexcept;
 
