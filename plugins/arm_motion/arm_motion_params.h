@@ -19,7 +19,9 @@
 //   check_step_mm: 5                 # their spacing (and check_step_rad in rotation)
 //   check_step_rad: 0.05
 //   joint_speed_fraction: 0.9        # of each joint's URDF velocity limit a path may need
-//   rest_posture_deg: [0, 28.6, 0, 80.2, 0, 68.8, 0]   # the IK's null-space preference
+//   rest_posture_deg: [...]          # the IK's null-space preference (7 angles, S1..W2); default
+//                                    #   per side: the palm flat 150 mm above the table, fingers
+//                                    #   forward (right: -36 -19.5 -15.1 54.9 54 71.2 148.3)
 //   track_iterations: 4              # IK iterations per cycle at most
 // Non-RT.
 #pragma once
