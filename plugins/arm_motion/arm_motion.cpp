@@ -170,8 +170,11 @@ void ArmMotion::check_path(const CycleInputs& in) noexcept {
     double q[kArmJoints];
     std::memcpy(q, s_.q_check, sizeof(q));
     robot::ArmIk::Result r;
+    const auto close = [&] {
+      return r.error_m <= p_.tracking_tolerance_mm * 1e-3 && r.error_rad <= p_.tracking_tolerance_rad;
+    };
     for (int tries = 0; tries < 3 && !r.converged; ++tries) r = ik_.track(target, std::span<double, kArmJoints>(q, kArmJoints));
-    if (!r.converged) {
+    if (!r.converged && !close()) {
       refuse(s_.status.goal_id, ArmMotionReason::unreachable);
       s_.phase = ArmMotionStatus::unreachable;
       s_.status.reason = static_cast<std::uint8_t>(ArmMotionReason::unreachable);

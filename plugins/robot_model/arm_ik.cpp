@@ -77,23 +77,32 @@ void ArmIk::random_seed(std::span<double, kArmJoints> q) noexcept {
 }
 
 bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step,
-                    Result& r) noexcept {
+                    double tol_m, double tol_rad, Result& r) noexcept {
   bool null_pending = rest_gain > 0;
   bool locked[kArmJoints] = {};
   for (int it = 0;; ++it) {
     if (fk_->JntToCart(q_, f_) < 0) return false;
     const KDL::Frame tool = f_ * flange_tool_;
-    const KDL::Twist err = KDL::diff(tool, target);  // vel: position error, rot: world axis-angle
-    r.error_m = err.vel.Norm();
-    r.error_rad = err.rot.Norm();
-    const bool converged = r.error_m < opt_.tolerance_m && r.error_rad < opt_.tolerance_rad;
+    // Position error, and the orientation error 1/2 sum_i (r_i x r_target_i) = sin(theta) axis
+    // (exact at small angles: KDL::diff reads rotations under ~1e-6 rad as none).
+    const KDL::Vector ev = target.p - tool.p;
+    const KDL::Vector er = 0.5 * (tool.M.UnitX() * target.M.UnitX() + tool.M.UnitY() * target.M.UnitY() +
+                                  tool.M.UnitZ() * target.M.UnitZ());
+    r.error_m = std::sqrt(KDL::dot(ev, ev));
+    r.error_rad = std::sqrt(KDL::dot(er, er));
+    // Beyond 90 deg sin(theta) falls again: count the angle as at least 1 there.
+    if (KDL::dot(tool.M.UnitX(), target.M.UnitX()) + KDL::dot(tool.M.UnitY(), target.M.UnitY()) +
+            KDL::dot(tool.M.UnitZ(), target.M.UnitZ()) < 1.0) {
+      r.error_rad = std::max(r.error_rad, 1.0);
+    }
+    const bool converged = r.error_m < tol_m && r.error_rad < tol_rad;
     if ((converged && !null_pending) || it >= max_iterations) return converged;
 
     if (jac_->JntToJac(q_, j_) < 0) return false;
     j_.changeRefPoint(f_.M * flange_tool_.p);  // the tool frame's origin
     Mat67 J = j_.data;
     Vec6 e;
-    e << err.vel.x(), err.vel.y(), err.vel.z(), err.rot.x(), err.rot.y(), err.rot.z();
+    e << ev.x(), ev.y(), ev.z(), er.x(), er.y(), er.z();
     // A locked joint comes free when the error pulls it back inside its range.
     const Vec7 g = J.transpose() * e;
     for (int j = 0; j < kArmJoints; ++j) {
@@ -142,7 +151,8 @@ ArmIk::Result ArmIk::solve(const KDL::Frame& target, std::span<const double, kAr
     if (a > 0) random_seed(start);
     for (int j = 0; j < kArmJoints; ++j) q_(j) = start[j];
     attempt = Result{};
-    const bool ok = iterate(target, opt_.max_iterations, a == 0 ? opt_.rest_gain : 0.0, opt_.max_step_rad, attempt);
+    const bool ok = iterate(target, opt_.max_iterations, a == 0 ? opt_.rest_gain : 0.0, opt_.max_step_rad, opt_.tolerance_m,
+                            opt_.tolerance_rad, attempt);
     r.iterations += attempt.iterations;
     r.attempts = a + 1;
     // Best: converged first, then the smaller error (1 mm counts as 1 mrad).
@@ -164,7 +174,8 @@ ArmIk::Result ArmIk::track(const KDL::Frame& target, std::span<double, kArmJoint
   Result r;
   for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
   r.attempts = 1;
-  r.converged = iterate(target, opt_.track_iterations, opt_.track_rest_gain, opt_.track_rest_max_step_rad, r);
+  r.converged = iterate(target, opt_.track_iterations, opt_.track_rest_gain, opt_.track_rest_max_step_rad,
+                        opt_.track_tolerance_m, opt_.track_tolerance_rad, r);
   for (int j = 0; j < kArmJoints; ++j) q[j] = q_(j);
   return r;
 }

@@ -55,6 +55,8 @@ class ArmIk {
     int track_iterations = 4;       // per track() call
     double tolerance_m = 1e-6;      // converged: position error below this (1 um) ...
     double tolerance_rad = 1e-6;    // ... and rotation error below this (1 urad)
+    double track_tolerance_m = 1e-9;    // track()'s: a command smooth to the nanometre (its
+    double track_tolerance_rad = 1e-9;  //   second differences are accelerations)
     double lambda0 = 1e-3;          // damping floor (m-equivalent): bounds steps at singularities
     double lambda_per_error = 0.5;  // lambda^2 += (this * |e|)^2
     double max_step_rad = 0.3;      // per iteration, per joint
@@ -111,7 +113,8 @@ class ArmIk {
 
  private:
   // Iterations from q_ (in place); returns whether converged. ITERATIONS counted in R.
-  bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step, Result& r) noexcept;
+  bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step, double tol_m,
+               double tol_rad, Result& r) noexcept;
   void error_of(const KDL::Frame& flange_target, double& e_m, double& e_rad) noexcept;
   void random_seed(std::span<double, kArmJoints> q) noexcept;
 

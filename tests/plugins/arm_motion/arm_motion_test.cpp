@@ -30,13 +30,13 @@ Joints q_cmd(const Rig& r) {
 // Speeds and accelerations of the tool frame along the cycles (from FK of q_cmd).
 struct Trace {
   std::vector<KDL::Frame> pose;
-  [[nodiscard]] double speed_mm_s(std::size_t i) const { return i == 0 ? 0 : 1e6 * (pose[i].p - pose[i - 1].p).Norm(); }
+  [[nodiscard]] double speed_mm_s(std::size_t i) const { return i == 0 ? 0 : 1e6 * norm((pose[i].p - pose[i - 1].p)); }
   [[nodiscard]] double accel_mm_s2(std::size_t i) const {
     if (i < 2) return 0;
     const KDL::Vector v1 = pose[i].p - pose[i - 1].p, v0 = pose[i - 1].p - pose[i - 2].p;
-    return 1e9 * (v1 - v0).Norm();
+    return 1e9 * norm((v1 - v0));
   }
-  [[nodiscard]] double angular_speed(std::size_t i) const { return i == 0 ? 0 : 1e3 * KDL::diff(pose[i - 1].M, pose[i].M).Norm(); }
+  [[nodiscard]] double angular_speed(std::size_t i) const { return i == 0 ? 0 : 1e3 * rot_angle(pose[i - 1].M, pose[i].M); }
   [[nodiscard]] double max_speed() const {
     double m = 0;
     for (std::size_t i = 1; i < pose.size(); ++i) m = std::max(m, speed_mm_s(i));
@@ -86,7 +86,7 @@ TEST_CASE("a motion reaches its target within the goal's limits; its final comma
   CHECK(st.goals_accepted == 1);
   const KDL::Frame end = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
   CHECK(mm(end.p - target.p) < 0.01);
-  CHECK(1e3 * KDL::diff(end.M, target.M).Norm() < 0.01);
+  CHECK(1e3 * rot_angle(end.M, target.M) < 0.01);
   // Within the limits, every cycle (the path is straight: its acceleration is along it).
   CHECK(t.max_speed() <= 100.0 * 1.001);
   CHECK(t.max_speed() >= 99.0);  // and it did cruise at the speed asked

@@ -115,7 +115,7 @@ TEST_CASE("a motion brings the world's fingertip pad to its target within 0.05 m
   REQUIRE(w.motion->status().state == ArmMotionStatus::reached);
   for (int i = 0; i < 20; ++i) w.cycle();  // held
   const KDL::Frame end = w.pad();
-  const double err_mm = mm(end.p - target.p), err_mrad = 1e3 * KDL::diff(end.M, target.M).Norm();
+  const double err_mm = mm(end.p - target.p), err_mrad = 1e3 * rot_angle(end.M, target.M);
   std::printf("world pad: %.2g mm, %.2g mrad from the target after %d cycles\n", err_mm, err_mrad, n);
   CHECK(err_mm < 0.05);
   CHECK(err_mrad < 0.1);
@@ -158,13 +158,13 @@ TEST_CASE("a descent onto the sheet stopped on the contact onset decelerates wit
   }
   REQUIRE(onset_cycle >= 2);
   CHECK(w.motion->status().state == ArmMotionStatus::stopped_on_contact);
-  const auto speed = [&](std::size_t i) { return 1e6 * (p[i] - p[i - 1]).Norm(); };  // mm/s
+  const auto speed = [&](std::size_t i) { return 1e6 * norm((p[i] - p[i - 1])); };  // mm/s
   double max_decel = 0;
   for (std::size_t i = static_cast<std::size_t>(onset_cycle) + 1; i < p.size(); ++i) {
     max_decel = std::max(max_decel, 1e3 * std::abs(speed(i) - speed(i - 1)));
   }
   const double v_onset = speed(static_cast<std::size_t>(onset_cycle) - 1);
-  const double travel_mm = 1e3 * (p.back() - p[static_cast<std::size_t>(onset_cycle) - 1]).Norm();
+  const double travel_mm = 1e3 * norm((p.back() - p[static_cast<std::size_t>(onset_cycle) - 1]));
   std::printf("stop on contact: %zu cycles, %.1f mm/s at the onset, decelerated at up to %.0f mm/s^2, %.3f mm further, "
               "penetration %.3f mm\n",
               p.size() - static_cast<std::size_t>(onset_cycle), v_onset, max_decel, travel_mm, w.world->max_penetration_mm());
@@ -180,5 +180,5 @@ TEST_CASE("a descent onto the sheet stopped on the contact onset decelerates wit
   // Held: the world's arm stays put.
   const KDL::Vector rest = w.pad_applied();
   for (int i = 0; i < 200; ++i) w.cycle();
-  CHECK(1e3 * (w.pad_applied() - rest).Norm() < 1e-6);
+  CHECK(1e3 * norm((w.pad_applied() - rest)) < 1e-6);
 }

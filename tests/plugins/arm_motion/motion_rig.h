@@ -5,6 +5,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -151,6 +152,15 @@ inline void add_point(ArmGoal& g, const KDL::Frame& pose) {
   pose.M.GetQuaternion(g.orientation[k][0], g.orientation[k][1], g.orientation[k][2], g.orientation[k][3]);
 }
 
-inline double mm(const KDL::Vector& v) { return 1000.0 * v.Norm(); }
+// Exact at small differences (KDL's Norm and diff read values under 1e-6 as 0).
+inline double norm(const KDL::Vector& v) { return std::sqrt(KDL::dot(v, v)); }
+inline double mm(const KDL::Vector& v) { return 1000.0 * norm(v); }
+// The angle between two rotations: |A - B|_F = 2 sqrt(2) sin(theta / 2).
+inline double rot_angle(const KDL::Rotation& a, const KDL::Rotation& b) {
+  double f = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) f += (a(i, j) - b(i, j)) * (a(i, j) - b(i, j));
+  return 2.0 * std::asin(std::min(1.0, std::sqrt(f) / (2.0 * std::sqrt(2.0))));
+}
 
 }  // namespace rig

@@ -1,0 +1,77 @@
+// The checks of a goal's own content, one reason at a time, in their stated order.
+#include "plugins/arm_motion/goal_check.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+using namespace crease;
+using namespace crease::arm_motion;
+
+namespace {
+ArmGoal good() {
+  ArmGoal g;
+  g.point_count = 2;
+  g.speed_mm_s = 100;
+  g.accel_mm_s2 = 1000;
+  g.angular_speed_rad_s = 1;
+  g.angular_accel_rad_s2 = 10;
+  g.stop_accel_mm_s2 = 2000;
+  for (auto& q : g.orientation) q[3] = 1;
+  return g;
+}
+}  // namespace
+
+TEST_CASE("each defect of a goal names its reason") {
+  const GoalLimits l;
+  CHECK(check_goal(good(), l) == ArmMotionReason::none);
+  ArmGoal g = good();
+  g.kind = 9;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+  g = good();
+  g.stop_on = 5;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+  g = good();
+  g.stop_on = ArmGoal::contact_onset;
+  g.stop_fingers = 0;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+  g = good();
+  g.tool = 12;
+  CHECK(check_goal(g, l) == ArmMotionReason::unknown_tool);
+  g = good();
+  g.position_mm[1][2] = INFINITY;
+  CHECK(check_goal(g, l) == ArmMotionReason::non_finite);
+  g = good();
+  g.position_mm[2][2] = NAN;  // beyond point_count: not looked at
+  CHECK(check_goal(g, l) == ArmMotionReason::none);
+  g = good();
+  g.orientation[1][0] = NAN;
+  CHECK(check_goal(g, l) == ArmMotionReason::non_finite);
+  g = good();
+  g.angular_accel_rad_s2 = NAN;
+  CHECK(check_goal(g, l) == ArmMotionReason::non_finite);
+  g = good();
+  g.orientation[1][3] = 0.99;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_orientation);
+  g = good();
+  g.angular_speed_rad_s = 1.6f;  // above 1.5
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_limits);
+  g = good();
+  g.stop_accel_mm_s2 = 6000;  // above 5000
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_limits);
+  g = good();
+  g.speed_mm_s = -1;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_limits);
+  ArmGoal stop;
+  stop.kind = ArmGoal::stop;  // nothing else read
+  stop.speed_mm_s = NAN;
+  CHECK(check_goal(stop, l) == ArmMotionReason::none);
+}
+
+TEST_CASE("the workspace box holds its faces and refuses what lies beyond or is not a number") {
+  const Workspace w;
+  const double in[3] = {0, 0, -10}, out[3] = {0, 0, -10.001}, nan[3] = {0, NAN, 0};
+  CHECK(w.contains(in));
+  CHECK_FALSE(w.contains(out));
+  CHECK_FALSE(w.contains(nan));
+}
