@@ -33,9 +33,7 @@ ArmIk::ArmIk(const RobotModel& model, Side side, const Options& options) : opt_(
     }
   }
   fk_ = std::make_unique<KDL::ChainFkSolverPos_recursive>(*chain_);
-  jac_ = std::make_unique<KDL::ChainJntToJacSolver>(*chain_);
   q_.resize(kArmJoints);
-  j_.resize(kArmJoints);
   tools_.reserve(kToolFrames);
   for (int f = 0; f < kToolFrames; ++f) {
     tools_.push_back(model.make_chain(side, prefix + std::string(kToolFrameLinks[f])));
@@ -65,6 +63,39 @@ KDL::Frame ArmIk::tool_pose(std::span<const double, kArmJoints> q) noexcept {
   return f_ * flange_tool_;
 }
 
+void ArmIk::pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept {
+  // One pass down the chain: each joint's axis and origin in the world before its own motion,
+  // then the flange; column j = [a_j x (p_tool - o_j); a_j] (the geometric Jacobian at the
+  // tool frame's origin, what KDL's ChainJntToJacSolver with changeRefPoint gives).
+  KDL::Vector axis[kArmJoints], origin[kArmJoints];
+  KDL::Frame t = KDL::Frame::Identity();
+  int j = 0;
+  for (const KDL::Segment& seg : chain_->segments) {
+    const KDL::Joint& joint = seg.getJoint();
+    if (joint.getType() == KDL::Joint::None) {
+      t = t * seg.pose(0.0);
+      continue;
+    }
+    axis[j] = t.M * joint.JointAxis();
+    origin[j] = t * joint.JointOrigin();
+    t = t * seg.pose(q_(j));
+    ++j;
+  }
+  f_ = t;
+  const KDL::Vector p_tool = t * flange_tool_.p;
+  for (int k = 0; k < kArmJoints; ++k) {
+    const KDL::Vector v = axis[k] * (p_tool - origin[k]);
+    J.col(k) << v.x(), v.y(), v.z(), axis[k].x(), axis[k].y(), axis[k].z();
+  }
+}
+
+Eigen::Matrix<double, 6, kArmJoints> ArmIk::tool_jacobian(std::span<const double, kArmJoints> q) noexcept {
+  for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
+  Eigen::Matrix<double, 6, kArmJoints> J;
+  pose_and_jacobian(J);
+  return J;
+}
+
 void ArmIk::random_seed(std::span<double, kArmJoints> q) noexcept {
   for (int j = 0; j < kArmJoints; ++j) {
     rng_ ^= rng_ << 13;  // xorshift64
@@ -80,8 +111,9 @@ bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_ga
                     double tol_m, double tol_rad, Result& r) noexcept {
   bool null_pending = rest_gain > 0;
   bool locked[kArmJoints] = {};
+  Mat67 J;
   for (int it = 0;; ++it) {
-    if (fk_->JntToCart(q_, f_) < 0) return false;
+    pose_and_jacobian(J);
     const KDL::Frame tool = f_ * flange_tool_;
     // Position error, and the orientation error 1/2 sum_i (r_i x r_target_i) = sin(theta) axis
     // (exact at small angles: KDL::diff reads rotations under ~1e-6 rad as none).
@@ -98,9 +130,6 @@ bool ArmIk::iterate(const KDL::Frame& target, int max_iterations, double rest_ga
     const bool converged = r.error_m < tol_m && r.error_rad < tol_rad;
     if ((converged && !null_pending) || it >= max_iterations) return converged;
 
-    if (jac_->JntToJac(q_, j_) < 0) return false;
-    j_.changeRefPoint(f_.M * flange_tool_.p);  // the tool frame's origin
-    Mat67 J = j_.data;
     Vec6 e;
     e << ev.x(), ev.y(), ev.z(), er.x(), er.y(), er.z();
     // A locked joint comes free when the error pulls it back inside its range.

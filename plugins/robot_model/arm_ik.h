@@ -11,8 +11,9 @@
 //
 //   dq = J^T (J J^T + lambda^2 I)^-1 e  +  N k (q_rest - q),   N = I - J^+ J
 //
-// e the flange's pose error (position m, rotation rad as a world axis-angle), J the 6x7
-// geometric Jacobian (KDL's ChainJntToJacSolver), lambda^2 = lambda0^2 + c |e|^2 (damped least
+// e the tool frame's pose error (position m; rotation 1/2 sum r_i x r_target_i = sin(theta) axis,
+// exact at small angles), J the 6x7 geometric Jacobian at the tool frame's origin (one pass down
+// the chain, the pose with it; equal to KDL's ChainJntToJacSolver), lambda^2 = lambda0^2 + c |e|^2 (damped least
 // squares, Levenberg-Marquardt style: robust far from the target, quadratic near it, bounded at
 // singularities); the second term is the stated redundancy resolution: in the Jacobian's null
 // space, towards a rest posture (by default elbow bent, wrist bent: the posture the arms work
@@ -30,9 +31,9 @@
 
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/chainjnttojacsolver.hpp>
 #include <kdl/frames.hpp>
-#include <kdl/jacobian.hpp>
+
+#include <Eigen/Core>
 #include <kdl/jntarray.hpp>
 
 #include <array>
@@ -96,6 +97,8 @@ class ArmIk {
 
   // RT. The tool frame's world pose at arm angles Q (with the offset set last).
   [[nodiscard]] KDL::Frame tool_pose(std::span<const double, kArmJoints> q) noexcept;
+  // RT. The geometric Jacobian (linear rows first) at the tool frame's origin, world frame.
+  [[nodiscard]] Eigen::Matrix<double, 6, kArmJoints> tool_jacobian(std::span<const double, kArmJoints> q) noexcept;
 
   // RT. Arm angles Q putting the tool frame at TARGET (world, metres), starting from SEED,
   // restarting when an attempt does not converge. Q is the best attempt's even when it failed.
@@ -115,17 +118,15 @@ class ArmIk {
   // Iterations from q_ (in place); returns whether converged. ITERATIONS counted in R.
   bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step, double tol_m,
                double tol_rad, Result& r) noexcept;
-  void error_of(const KDL::Frame& flange_target, double& e_m, double& e_rad) noexcept;
+  void pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept;  // at q_; sets f_
   void random_seed(std::span<double, kArmJoints> q) noexcept;
 
   Options opt_;
   std::unique_ptr<KDL::Chain> chain_;  // heap: the solvers keep references to it
   std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk_;
-  std::unique_ptr<KDL::ChainJntToJacSolver> jac_;
   std::vector<ToolChain> tools_;       // world -> each tool frame, for set_tool
   std::unique_ptr<ToolChain> flange_chain_;
   KDL::JntArray q_;
-  KDL::Jacobian j_;
   KDL::Frame f_;
   KDL::Frame flange_tool_ = KDL::Frame::Identity();
   KDL::Frame tool_flange_ = KDL::Frame::Identity();

@@ -6,6 +6,7 @@
 
 #include <doctest/doctest.h>
 #include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
 #include <kdl_parser/kdl_parser.hpp>
 
 #include <array>
@@ -114,6 +115,27 @@ TEST_CASE("forward kinematics: the flange and the tool frames equal KDL's own so
   CHECK(exact_norm((f.p - KDL::Vector(0.85, -0.45, 1.3 - 0.767))) < 1e-9);
   const KDL::Rotation r = KDL::Rotation::RotX(kPi) * KDL::Rotation::RotZ(90 * kDeg) * KDL::Rotation::RotX(90 * kDeg);
   CHECK(rot_angle(f.M, r) < 1e-9);
+}
+
+TEST_CASE("the Jacobian at the tool frame equals KDL's ChainJntToJacSolver moved to that point") {
+  ArmIk ik(model(), Side::left);
+  KDL::ChainJntToJacSolver kdl(ik.arm_chain());
+  KDL::ChainFkSolverPos_recursive fk(ik.arm_chain());
+  std::mt19937 rng(9);
+  for (int trial = 0; trial < 30; ++trial) {
+    const Joints q = random_arm(model(), Side::left, rng);
+    const Hand hand = random_hand(model(), Side::left, rng);
+    REQUIRE(ik.set_tool(static_cast<ToolFrame>(trial % kToolFrames), q, hand));
+    KDL::JntArray kq(kArmJoints);
+    for (int j = 0; j < kArmJoints; ++j) kq(j) = q[j];
+    KDL::Jacobian want(kArmJoints);
+    KDL::Frame flange;
+    REQUIRE(kdl.JntToJac(kq, want) >= 0);
+    REQUIRE(fk.JntToCart(kq, flange) >= 0);
+    want.changeRefPoint(flange.M * ik.tool_offset().p);
+    const auto got = ik.tool_jacobian(q);
+    CHECK((got - want.data).cwiseAbs().maxCoeff() < 1e-12);
+  }
 }
 
 TEST_CASE("round trips over random reachable poses within 0.1 mm and 0.1 mrad, inside the joint limits") {
