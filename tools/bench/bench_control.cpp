@@ -241,7 +241,7 @@ std::vector<double> bench_stage(RobotModel& m, double seconds, bool paced) {
       const auto st = arm.motion->status().state;
       const bool idle = st != ArmMotionStatus::checking && st != ArmMotionStatus::running &&
                         st != ArmMotionStatus::stopping;
-      if (idle && c % 50 == 0) {  // a new goal near the rest pose, every other one stopping on contact
+      if (idle && c % 50 == 0 && c > 0) {  // a new goal near the rest pose, every other one stopping on contact
         Joints qc{};
         for (int j = 0; j < kArmJoints; ++j) qc[j] = arm.motion->state().q_cmd[j];
         const ToolFrame tool = (id % 2 == 0) ? ToolFrame::ff_pad : ToolFrame::palm_front;
