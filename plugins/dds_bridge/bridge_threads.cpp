@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "core/errors.h"
 #include "participant.h"
 #include "rt/rt_setup.h"
 
@@ -62,7 +63,7 @@ SubscriberListeners::SubscriberListeners(std::vector<SubscribeLink*> links) : li
     set_status<dds_subscription_matched_status_t>(l, &dds_lset_subscription_matched);
     const dds_return_t rc = dds_set_listener(link->reader(), l);
     dds_delete_listener(l);
-    if (rc < 0) throw ParamError("subscribe", "cannot listen to the reader of " + link->topic());
+    if (rc < 0) throw crease::Error("cannot listen to the reader of " + link->topic());
     catch_up_statuses(link->reader(), link->counters());  // what came before the listener was set
     link->receive();
   }

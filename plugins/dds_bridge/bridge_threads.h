@@ -46,7 +46,7 @@ class PublisherThread {
 
 class SubscriberListeners {
  public:
-  // Throws ParamError when a listener cannot be set.
+  // Throws crease::Error when a listener cannot be set.
   explicit SubscriberListeners(std::vector<SubscribeLink*> links);
   ~SubscriberListeners();  // removes them; returns once no listener call is in progress
   SubscriberListeners(const SubscriberListeners&) = delete;

@@ -15,7 +15,7 @@
 // RT: update copies subscribed samples from the links' channels into their ports; the write
 // phase copies new values of published ports into the links' channels and wakes the publisher
 // thread. Every DDS call runs on the bridge's thread or Cyclone's (bridge_threads.h), never a loop's.
-#include <filesystem>
+#include <algorithm>
 #include <memory>
 #include <set>
 #include <string>
@@ -30,11 +30,6 @@
 namespace {
 
 using namespace crease::dds_bridge;
-
-std::string path_param(const crease::Params& p, const std::string& value) {
-  if (std::filesystem::path(value).is_absolute()) return value;
-  return (std::filesystem::path(p.file()).parent_path() / value).string();
-}
 
 // The payload kind of an entry: its `type:`, or the type of the port as already bound.
 const PayloadKind& kind_of(const crease::Params& entry, const crease::PortBinder& ports, const std::string& port) {
@@ -62,13 +57,25 @@ const PayloadKind& kind_of(const crease::Params& entry, const crease::PortBinder
 class DdsBridge final : public crease::Plugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
-    const std::string xml = path_param(p, p.get<std::string>("dds_config", "dds/loopback.xml"));
+    const std::string xml = p.get_path("dds_config", "dds/loopback.xml");
     const int domain = p.get_in_range<int>("domain", -1, 0, Participant::kMaxDomainId);
     const int priority = p.get_in_range<int>("thread_priority", 0, 0, 98);
+    // The domain: `domain` when given (it must be the one the XML names, if it names one), else
+    // the XML's, else 0. The file's errors (crease::Error, naming it) are the parameter's.
+    int xml_domain = -1;
     try {
-      participant_ = std::make_unique<Participant>(xml, p.has("domain") ? domain : -1);
-    } catch (const ParamError& e) {
-      p.fail(e.key(), e.what());
+      xml_domain = Participant::configured_domain(xml);
+    } catch (const crease::Error& e) {
+      p.fail("dds_config", e.what());
+    }
+    if (p.has("domain") && xml_domain >= 0 && domain != xml_domain)
+      p.fail("domain", "is " + std::to_string(domain) + " but " + xml + " configures domain " +
+                           std::to_string(xml_domain) + " only");
+    try {
+      participant_ =
+          std::make_unique<Participant>(xml, p.has("domain") ? domain : std::max(xml_domain, 0));
+    } catch (const crease::Error& e) {
+      p.fail("dds_config", e.what());
     }
     const std::vector<crease::Params> pubs = p.list("publish");
     const std::vector<crease::Params> subs = p.list("subscribe");
@@ -98,8 +105,8 @@ class DdsBridge final : public crease::Plugin {
     if (!sl.empty()) {
       try {
         subscriber_ = std::make_unique<SubscriberListeners>(std::move(sl));
-      } catch (const ParamError& e) {
-        p.fail(e.key(), e.what());
+      } catch (const crease::Error& e) {
+        p.fail("subscribe", e.what());
       }
     }
   }
@@ -158,8 +165,10 @@ class DdsBridge final : public crease::Plugin {
       }
     } catch (const crease::PortError& err) {
       e.fail("port", err.what());
-    } catch (const ParamError& err) {
-      e.fail(err.key(), err.what());
+    } catch (const crease::ConfigError&) {
+      throw;  // already names its file, line and key
+    } catch (const crease::Error& err) {
+      e.fail("topic", err.what());  // DDS refused the topic or its endpoint
     }
   }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/errors.h"
 #include "participant.h"
 
 namespace crease::dds_bridge {
@@ -12,15 +13,15 @@ Endpoint::Endpoint(dds_entity_t participant, const dds_topic_descriptor_t* type,
   const QosPtr q = make_qos(qos);
   topic_ = dds_create_topic(participant, type, topic.c_str(), q.get(), nullptr);
   if (topic_ < 0)
-    throw ParamError("topic", "DDS refused topic " + topic + " of type " + type->m_typename + ": " +
-                                  dds_strretcode(topic_));
+    throw crease::Error("DDS refused topic " + topic + " of type " + type->m_typename + ": " +
+                        dds_strretcode(topic_));
   endpoint_ = writer ? dds_create_writer(participant, topic_, q.get(), nullptr)
                      : dds_create_reader(participant, topic_, q.get(), nullptr);
   if (endpoint_ < 0) {
     const std::string why = dds_strretcode(endpoint_);
     dds_delete(topic_);
-    throw ParamError("topic", std::string("DDS refused a ") + (writer ? "writer" : "reader") + " of " + topic +
-                                  " with this QoS: " + why);
+    throw crease::Error(std::string("DDS refused a ") + (writer ? "writer" : "reader") + " of " +
+                        topic + " with this QoS: " + why);
   }
 }
 

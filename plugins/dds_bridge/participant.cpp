@@ -8,6 +8,7 @@
 #include <regex>
 #include <sstream>
 
+#include "core/errors.h"
 #include "dds_log.h"
 
 namespace crease::dds_bridge {
@@ -29,10 +30,10 @@ std::map<dds_domainid_t, DomainEntry>& domains() {
 
 std::string read_file(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
-  if (!f) throw ParamError("dds_config", "cannot read " + path + ": " + std::strerror(errno));
+  if (!f) throw crease::Error("cannot read " + path + ": " + std::strerror(errno));
   std::ostringstream s;
   s << f.rdbuf();
-  if (f.bad()) throw ParamError("dds_config", "cannot read " + path);
+  if (f.bad()) throw crease::Error("cannot read " + path);
   return s.str();
 }
 
@@ -42,27 +43,28 @@ int xml_domain_id(const std::string& xml, const std::string& path) {
   static const std::regex id_attr(R"(\bId\s*=\s*["']\s*([^"']*?)\s*["'])", std::regex::icase);
   std::smatch m;
   if (!std::regex_search(xml, m, domain_tag))
-    throw ParamError("dds_config", path + " has no <Domain> element (so nothing says which interfaces to use)");
+    throw crease::Error(path +
+                        " has no <Domain> element (so nothing says which interfaces to use)");
   const std::string attrs = m[1].str();
   std::smatch id;
   if (!std::regex_search(attrs, id, id_attr) || id[1].str() == "any") return -1;
   const std::string v = id[1].str();
   if (v.empty() || v.find_first_not_of("0123456789") != std::string::npos || v.size() > 3 ||
       std::stoi(v) > Participant::kMaxDomainId)
-    throw ParamError("dds_config", path + ": <Domain Id=\"" + v + "\"> is not a domain id 0.." +
-                                       std::to_string(Participant::kMaxDomainId) + " or \"any\"");
+    throw crease::Error(path + ": <Domain Id=\"" + v + "\"> is not a domain id 0.." +
+                        std::to_string(Participant::kMaxDomainId) + " or \"any\"");
   return std::stoi(v);
 }
 
 }  // namespace
 
+int Participant::configured_domain(const std::string& xml_path) {
+  return xml_domain_id(read_file(xml_path), xml_path);
+}
+
 Participant::Participant(const std::string& xml_path, int domain_id) {
   const std::string xml = read_file(xml_path);
-  const int xml_id = xml_domain_id(xml, xml_path);
-  if (domain_id >= 0 && xml_id >= 0 && domain_id != xml_id)
-    throw ParamError("domain", "is " + std::to_string(domain_id) + " but " + xml_path + " configures domain " +
-                                   std::to_string(xml_id) + " only");
-  domain_ = static_cast<dds_domainid_t>(domain_id >= 0 ? domain_id : (xml_id >= 0 ? xml_id : 0));
+  domain_ = static_cast<dds_domainid_t>(domain_id);
 
   const std::lock_guard lock(g_mu);
   DomainEntry& e = domains()[domain_];
@@ -75,13 +77,15 @@ Participant::Participant(const std::string& xml_path, int domain_id) {
       domains().erase(domain_);
       std::string why = capture.text();
       while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
-      throw ParamError("dds_config", "CycloneDDS refused " + xml_path + " for domain " + std::to_string(domain_) +
-                                         " (" + dds_strretcode(d) + (why.empty() ? "" : ": " + why) + ")");
+      throw crease::Error("CycloneDDS refused " + xml_path + " for domain " +
+                          std::to_string(domain_) + " (" + dds_strretcode(d) +
+                          (why.empty() ? "" : ": " + why) + ")");
     }
     e = DomainEntry{d, xml, xml_path, 0};
   } else if (e.xml != xml) {
-    throw ParamError("dds_config", "domain " + std::to_string(domain_) + " already runs in this process with " +
-                                       e.path + ", which differs from " + xml_path);
+    throw crease::Error("domain " + std::to_string(domain_) +
+                        " already runs in this process with " + e.path + ", which differs from " +
+                        xml_path);
   }
   participant_ = dds_create_participant(domain_, nullptr, nullptr);
   if (participant_ < 0) {
@@ -91,7 +95,7 @@ Participant::Participant(const std::string& xml_path, int domain_id) {
       domains().erase(domain_);
       DdsLog::instance().release();
     }
-    throw ParamError("dds_config", "no participant on domain " + std::to_string(domain_) + ": " + why);
+    throw crease::Error("no participant on domain " + std::to_string(domain_) + ": " + why);
   }
   ++e.users;
 }

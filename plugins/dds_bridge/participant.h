@@ -8,29 +8,24 @@
 
 #include <dds/dds.h>
 
-#include <stdexcept>
 #include <string>
 
 namespace crease::dds_bridge {
 
-// A configuration error about one parameter (`key`); the plugin adds file, line and path.
-class ParamError : public std::runtime_error {
- public:
-  ParamError(std::string key, const std::string& reason) : std::runtime_error(reason), key_(std::move(key)) {}
-  [[nodiscard]] const std::string& key() const noexcept { return key_; }
-
- private:
-  std::string key_;
-};
-
+// Errors are crease::Error naming the file and the reason (core/assert.h: a failure of the
+// environment at configure time); the plugin attributes them to the parameter that named the
+// file (Params::fail: file, line and key).
 class Participant {
  public:
   static constexpr int kMaxDomainId = 230;  // DDS: ports of higher ids overflow 16 bits
 
-  // Reads `xml_path` and joins domain `domain_id`, or when it is -1 the id the XML names
-  // (<Domain Id="N">; 0 when it says "any" or nothing). Throws ParamError naming "dds_config"
-  // (unreadable file, no <Domain>, refused by Cyclone: with Cyclone's reason, another file already
-  // configures this domain) or "domain" (differs from the XML's id).
+  // The domain id the CycloneDDS XML at `xml_path` names (<Domain Id="N">), -1 when it says
+  // "any" or nothing. Throws crease::Error: unreadable file, no <Domain>, not an id.
+  [[nodiscard]] static int configured_domain(const std::string& xml_path);
+
+  // Reads `xml_path` and joins domain `domain_id` (0..kMaxDomainId; the caller checked it
+  // against configured_domain). Throws crease::Error: unreadable file, refused by Cyclone (with
+  // Cyclone's reason), another file already configures this domain in this process.
   Participant(const std::string& xml_path, int domain_id);
   ~Participant();
   Participant(const Participant&) = delete;

@@ -1,6 +1,6 @@
 #include "plugins/robot_model/tool_chain.h"
 
-#include <stdexcept>
+#include "core/assert.h"
 
 namespace crease::robot {
 
@@ -10,12 +10,13 @@ ToolChain::ToolChain(std::string tip, const KDL::Chain& chain, std::vector<Joint
       fk_(std::make_unique<KDL::ChainFkSolverPos_recursive>(*chain_)),
       q_(chain.getNrOfJoints()),
       sources_(std::move(sources)) {
-  if (sources_.size() != chain_->getNrOfJoints()) {
-    throw std::invalid_argument("ToolChain " + tip_ + ": one source per chain joint");
-  }
+  // RobotModel::make_chain builds the sources from the validated model (a bad URDF or parameter
+  // file fails there, naming the file, line and joint): a mismatch here is a bug.
+  CREASE_DEMAND(sources_.size() == chain_->getNrOfJoints(),
+                "ToolChain: one source per chain joint");
   for (const auto& s : sources_) {
     const int n = s.kind == JointSource::arm ? kArmJoints : kHandJoints;
-    if (s.index < 0 || s.index >= n) throw std::invalid_argument("ToolChain " + tip_ + ": source index");
+    CREASE_DEMAND(s.index >= 0 && s.index < n, "ToolChain: a source index out of its joint range");
   }
 }
 

@@ -36,7 +36,8 @@ using HandAngles = std::span<const double, kHandJoints>;  // rad, §3 order
 
 class ToolChain {
  public:
-  // SOURCES: one per movable joint of CHAIN, in chain order. Non-RT.
+  // SOURCES: one per movable joint of CHAIN, in chain order, each index within its arm's or
+  // hand's joints (CREASE_DEMAND: RobotModel builds them from the validated model). Non-RT.
   ToolChain(std::string tip, const KDL::Chain& chain, std::vector<JointSource> sources);
   ToolChain(ToolChain&&) = default;
   ToolChain& operator=(ToolChain&&) = default;

@@ -15,7 +15,7 @@
 
 #include "core/plugin.h"
 #include "core/port_types/sheet_state.h"
-#include "plugins/sheet_model/fold_script.h"
+#include "plugins/sim_world/scene/fold_script.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "keypoint_pipeline.h"
+#include "plugins/vision/keypoint_pipeline.h"
 
 #include <cmath>
 #include <string>

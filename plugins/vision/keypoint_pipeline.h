@@ -8,12 +8,12 @@
 
 #include <opencv2/core.hpp>
 
-#include "camera_model.h"
 #include "core/port_types/keypoints.h"
-#include "marker_detector.h"
-#include "marker_layout.h"
-#include "task_team.h"
-#include "triangulation.h"
+#include "plugins/camera_rig/camera_model.h"
+#include "plugins/camera_rig/marker_layout.h"
+#include "plugins/vision/marker_detector.h"
+#include "plugins/vision/task_team.h"
+#include "plugins/vision/triangulation.h"
 
 namespace crease::vision {
 

@@ -1,11 +1,11 @@
-#include "marker_detector.h"
+#include "plugins/vision/marker_detector.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
-#include "marker_layout.h"
+#include "plugins/camera_rig/marker_layout.h"
 
 namespace crease::vision {
 

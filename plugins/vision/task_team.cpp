@@ -1,4 +1,4 @@
-#include "task_team.h"
+#include "plugins/vision/task_team.h"
 
 #include "core/assert.h"
 

@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "camera_model.h"
+#include "plugins/camera_rig/camera_model.h"
 
 namespace crease::vision {
 

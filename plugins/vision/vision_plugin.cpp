@@ -24,8 +24,8 @@
 #include "core/plugin.h"
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
-#include "images_port.h"
-#include "vision_worker.h"
+#include "plugins/camera_rig/images_port.h"
+#include "plugins/vision/vision_worker.h"
 
 namespace {
 

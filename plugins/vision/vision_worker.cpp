@@ -1,8 +1,8 @@
-#include "vision_worker.h"
+#include "plugins/vision/vision_worker.h"
 
 #include "core/assert.h"
 
-#include "camera_worker.h"
+#include "plugins/camera_rig/images_port.h"
 
 namespace crease::vision {
 

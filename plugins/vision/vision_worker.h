@@ -15,7 +15,7 @@
 
 #include "core/frames/frame_channel.h"
 #include "core/port_types/keypoints.h"
-#include "keypoint_pipeline.h"
+#include "plugins/vision/keypoint_pipeline.h"
 #include "rt/latest.h"
 
 namespace crease::vision {

@@ -30,11 +30,11 @@
 
 #include "bench_registry.h"
 #include "plugins/sheet_model/collision_world.h"
-#include "plugins/sheet_model/fold_script.h"
 #include "plugins/sheet_model/keypoint_predictor.h"
 #include "plugins/sheet_model/ode_sheet.h"
 #include "plugins/sheet_model/synthetic_markers.h"
 #include "plugins/sheet_model/xpbd_sheet.h"
+#include "plugins/sim_world/scene/fold_script.h"
 
 namespace {
 

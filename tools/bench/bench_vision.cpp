@@ -17,10 +17,10 @@
 #include <opencv2/core/utility.hpp>
 
 #include "bench_registry.h"
-#include "keypoint_pipeline.h"
-#include "marker_sheet.h"
-#include "synthetic_truth.h"
-#include "view_renderer.h"
+#include "plugins/camera_rig/marker_sheet.h"
+#include "plugins/sim_world/scene/synthetic_truth.h"
+#include "plugins/sim_world/scene/view_renderer.h"
+#include "plugins/vision/keypoint_pipeline.h"
 
 namespace {
 

@@ -14,11 +14,13 @@
 #include <vector>
 
 #include "bench_registry.h"
-#include "camera_worker.h"
-#include "keypoint_pipeline.h"
-#include "marker_sheet.h"
+#include "plugins/camera_rig/images_port.h"
+#include "plugins/camera_rig/marker_sheet.h"
+#include "plugins/cameras/camera_worker.h"
+#include "plugins/sim_world/scene/sim_source.h"
+#include "plugins/vision/keypoint_pipeline.h"
+#include "plugins/vision/vision_worker.h"
 #include "rt/clock.h"
-#include "vision_worker.h"
 
 using namespace crease::vision;
 

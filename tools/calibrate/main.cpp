@@ -13,8 +13,8 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "calibration.h"
-#include "camera_model.h"
+#include "plugins/camera_rig/calibration.h"
+#include "plugins/camera_rig/camera_model.h"
 
 namespace cv_ = crease::vision;
 

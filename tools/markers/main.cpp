@@ -8,8 +8,8 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "marker_layout.h"
-#include "marker_sheet.h"
+#include "plugins/camera_rig/marker_layout.h"
+#include "plugins/camera_rig/marker_sheet.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"crease-markers: printable AprilTag sheet and its layout"};

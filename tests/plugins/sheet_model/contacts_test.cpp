@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "plugins/sheet_model/fold_script.h"
+#include "plugins/sim_world/scene/fold_script.h"
 
 using namespace crease::sheet;
 

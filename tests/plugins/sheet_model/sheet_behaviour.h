@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "plugins/sheet_model/collision_world.h"
-#include "plugins/sheet_model/fold_script.h"
 #include "plugins/sheet_model/sheet_model.h"
 #include "plugins/sheet_model/synthetic_markers.h"
+#include "plugins/sim_world/scene/fold_script.h"
 #include "rt/alloc_guard.h"
 
 namespace sheet_behaviour {

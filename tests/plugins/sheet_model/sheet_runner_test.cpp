@@ -9,8 +9,8 @@
 #include <numbers>
 #include <vector>
 
-#include "plugins/sheet_model/fold_script.h"
 #include "plugins/sheet_model/synthetic_markers.h"
+#include "plugins/sim_world/scene/fold_script.h"
 #include "rt/alloc_guard.h"
 
 using namespace crease::sheet;

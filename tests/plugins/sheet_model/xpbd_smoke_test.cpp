@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "plugins/sheet_model/collision_world.h"
-#include "plugins/sheet_model/fold_script.h"
 #include "plugins/sheet_model/keypoint_predictor.h"
 #include "plugins/sheet_model/synthetic_markers.h"
+#include "plugins/sim_world/scene/fold_script.h"
 
 using namespace crease::sheet;
 

@@ -1,4 +1,4 @@
-#include "keypoint_pipeline.h"
+#include "plugins/vision/keypoint_pipeline.h"
 
 #include <cmath>
 #include <map>
@@ -8,8 +8,8 @@
 
 #include <doctest/doctest.h>
 
-#include "synthetic_truth.h"
-#include "vision_fixture.h"
+#include "plugins/sim_world/scene/marker_scene.h"
+#include "plugins/sim_world/scene/synthetic_truth.h"
 
 using namespace crease::vision;
 using crease::vision::testing::Scene;

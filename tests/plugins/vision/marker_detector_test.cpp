@@ -1,10 +1,10 @@
-#include "marker_detector.h"
+#include "plugins/vision/marker_detector.h"
 
 #include <doctest/doctest.h>
 #include <opencv2/aruco.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "view_renderer.h"
+#include "plugins/sim_world/scene/view_renderer.h"
 
 using namespace crease::vision;
 

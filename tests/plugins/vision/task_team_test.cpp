@@ -1,7 +1,7 @@
 // TaskTeam: every task runs once per run on our own threads, its effects visible to the caller
 // after run(); exceptions come back to the caller; no thread but ours. Label `concurrency` too:
 // under ThreadSanitizer the tasks' plain writes check the hand-over in both directions.
-#include "task_team.h"
+#include "plugins/vision/task_team.h"
 
 #include <doctest/doctest.h>
 
@@ -9,17 +9,17 @@
 #include <vector>
 
 #include "support/abort_message.h"
-#include "vision_fixture.h"
+#include "support/opencv_threads.h"
 
 using crease::vision::TaskTeam;
 
 TEST_CASE("each task runs exactly once per run, and the caller sees its effects") {
-  crease::vision::testing::own_threads_only();
+  crease::testing::own_threads_only();
   for (const int helpers : {0, 1, 3}) {
     CAPTURE(helpers);
     TaskTeam team(helpers);
     CHECK(team.helpers() == helpers);
-    CHECK(crease::vision::testing::process_threads() == 1 + helpers);
+    CHECK(crease::testing::process_threads() == 1 + helpers);
     std::vector<int> runs(7, 0);  // plain ints: one writer per run and element
     std::vector<int> last(7, -1);
     int expected = 0;

@@ -1,4 +1,4 @@
-#include "triangulation.h"
+#include "plugins/vision/triangulation.h"
 
 #include <cmath>
 #include <random>

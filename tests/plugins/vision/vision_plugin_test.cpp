@@ -1,5 +1,5 @@
-// The camera source plugins (camera_replay, camera_sim, camera_v4l2) feeding the `vision`
-// plugin in a real loop: key-points on the `keypoints` port, frame sets through one frame
+// The camera source plugins (plugins/cameras: camera_replay, camera_sim on the sheet_truth
+// plugin's sheet, camera_v4l2) feeding the `vision` plugin in a real loop: key-points on the `keypoints` port, frame sets through one frame
 // channel (the host's port of kind frames that both dlopen'd plugins bound, listed with the
 // other ports); degraded, never stopped, when a camera stops; a replay processed twice gives
 // the same key-points; either end hot-swapped.
@@ -10,12 +10,13 @@
 #include <map>
 #include <thread>
 
-#include "camera_source.h"
 #include "core/daemon/views.h"
 #include "core/plugin_host.h"
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
-#include "marker_sheet.h"
+#include "plugins/camera_rig/marker_sheet.h"
+#include "plugins/cameras/camera_source.h"
+#include "plugins/sim_world/scene/sim_source.h"
 #include "rt/alloc_guard.h"
 
 using namespace std::chrono_literals;
@@ -72,6 +73,10 @@ struct Fixture {
     s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
     if (!channel.empty()) s.ports["images"] = channel;
     host.add_instance(s);
+  }
+  // The sheet camera_sim renders: the sheet_truth plugin's, on the `sheet_truth` port.
+  void add_truth(const std::string& more = "") {
+    add("truth", "sheet_truth", 1, "{announce_creases: false" + more + "}");
   }
   void add_vision(const std::string& cameras_dir, const std::string& channel,
                   const std::string& more = "") {
@@ -195,9 +200,8 @@ TEST_CASE("camera_replay -> vision twice: identical key-points, frame by frame")
 TEST_CASE("camera_sim -> vision with the shipped cameras and layout, recording what it renders") {
   const auto rec = tmp("simrec");
   Fixture fx;
-  fx.add("cameras", "camera_sim", 5,
-         "{occluders: 1, fold_start_s: 0, fold_duration_s: 1, record: '" + rec.string() + "'}",
-         "sim");
+  fx.add_truth(", start_s: 0");  // the half fold starts at once
+  fx.add("cameras", "camera_sim", 5, "{occluders: 1, record: '" + rec.string() + "'}", "sim");
   fx.add_vision("cameras", "sim", ", camera_threads: 3");  // cameras on threads of ours
   fx.host.start();
   REQUIRE(fx.wait_for([&] { return fx.read().frame >= 2; }));
@@ -274,6 +278,7 @@ TEST_CASE("camera_v4l2 on image sequences and a missing /dev/video: the others g
 
 TEST_CASE("hot swaps of camera_sim and vision: the new instances take over the channel's ends") {
   Fixture fx;
+  fx.add_truth();
   fx.add("cameras", "camera_sim", 5, "{}", "swap");
   fx.add_vision("cameras", "swap");
   fx.host.start();
@@ -304,6 +309,7 @@ TEST_CASE("hot swaps of camera_sim and vision: the new instances take over the c
 
 TEST_CASE("the frame channel between camera_sim and vision is listed with the ports") {
   Fixture fx;
+  fx.add_truth();
   fx.add("cameras", "camera_sim", 5, "{}");  // default names: images (frames), frames (latest)
   fx.add_vision("cameras", "");
   fx.host.start();

@@ -3,7 +3,7 @@
 // `concurrency` too: under ThreadSanitizer with OpenCV kept on our threads (own_threads_only),
 // TSan checks the channel hand-over (this thread writes, the worker reads) and the result
 // hand-off to the RT side.
-#include "vision_worker.h"
+#include "plugins/vision/vision_worker.h"
 
 #include <doctest/doctest.h>
 
@@ -11,10 +11,12 @@
 #include <cstring>
 #include <thread>
 
-#include "camera_worker.h"
+#include "plugins/camera_rig/images_port.h"
+#include "plugins/cameras/camera_worker.h"
+#include "plugins/sim_world/scene/marker_scene.h"
 #include "rt/alloc_guard.h"
 #include "support/abort_message.h"
-#include "vision_fixture.h"
+#include "support/opencv_threads.h"
 
 using namespace crease::vision;
 using namespace std::chrono_literals;
@@ -28,7 +30,7 @@ std::vector<Camera> small_rig() {
 }  // namespace
 
 TEST_CASE("each published set is detected once, without allocating on the RT side") {
-  crease::vision::testing::own_threads_only();
+  crease::testing::own_threads_only();
   crease::vision::testing::Scene s;
   const ViewRenderer r(face_texture(s.layout, Face::kFront, 4),
                        face_texture(s.layout, Face::kBack, 4), 4, small_rig());
@@ -74,7 +76,7 @@ TEST_CASE("each published set is detected once, without allocating on the RT sid
   CHECK(first_count > 20);  // key-points seen by both cameras
   CHECK(ch->consumed() == 4);
   CHECK(w.sets_processed() == 4);
-  CHECK(crease::vision::testing::process_threads() == 2);  // this one and the worker: no TBB
+  CHECK(crease::testing::process_threads() == 2);  // this one and the worker: no TBB
   if (crease::rt::alloc_hooks_installed()) {  // the counter would have seen an allocation
     crease::rt::ScopedRtMark mark;
     static char* volatile sink;  // keeps the allocation from being elided
@@ -99,7 +101,7 @@ TEST_CASE("calibrations that do not match the channel are a bug; a worker releas
 }
 
 TEST_CASE("cameras detected on helper threads of ours give the same key-points as one by one") {
-  crease::vision::testing::own_threads_only();
+  crease::testing::own_threads_only();
   crease::vision::testing::Scene s;
   const ViewRenderer r(face_texture(s.layout, Face::kFront, 4),
                        face_texture(s.layout, Face::kBack, 4), 4, small_rig());
@@ -124,7 +126,7 @@ TEST_CASE("cameras detected on helper threads of ours give the same key-points a
     }
     REQUIRE(t == VisionWorker::Take::fresh);
     // This thread, the worker and its threads - 1 helpers: all ours.
-    CHECK(crease::vision::testing::process_threads() == 1 + threads);
+    CHECK(crease::testing::process_threads() == 1 + threads);
   }
   REQUIRE(kps[0]->count > 20);
   REQUIRE(kps[0]->count == kps[1]->count);

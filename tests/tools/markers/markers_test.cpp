@@ -6,8 +6,8 @@
 #include <doctest/doctest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "marker_detector.h"
-#include "marker_layout.h"
+#include "plugins/camera_rig/marker_layout.h"
+#include "plugins/vision/marker_detector.h"
 
 using namespace crease::vision;
 

@@ -1,0 +1,200 @@
+#include "plugins/cameras/camera_source.h"
+
+#include <algorithm>
+#include <cinttypes>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/assert.h"
+#include "rt/clock.h"
+
+namespace crease::vision {
+
+namespace {
+std::string frame_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
+  char name[64];
+  std::snprintf(name, sizeof name, "/cam%zu/%06" PRIu64 ".png", cam, index);
+  return dir + name;
+}
+}  // namespace
+
+ReplaySource::ReplaySource(const std::string& dir) : dir_(dir) {
+  cameras_ = load_camera_dir(dir);
+  const std::string csv = dir + "/timestamps.csv";
+  std::ifstream in(csv);
+  crease::require_input(static_cast<bool>(in), csv + ": cannot read");
+  std::string line;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (lineno == 1 && line.rfind("frame", 0) == 0) continue;  // header
+    if (line.empty()) continue;
+    std::uint64_t f = 0;
+    long long t = 0;
+    char comma = 0;
+    std::istringstream ls(line);
+    crease::require_input(static_cast<bool>(ls >> f >> comma >> t) && comma == ',',
+                          csv + ": line " + std::to_string(lineno) + ": expected 'frame,timestamp_ns'");
+    stamps_.emplace_back(f, static_cast<std::int64_t>(t));
+  }
+}
+
+bool ReplaySource::grab(Frame& frame) {
+  if (next_ >= stamps_.size()) return false;
+  const auto [index, t] = stamps_[next_++];
+  frame.index = index;
+  frame.timestamp_ns = t;
+  frame.images.resize(cameras_.size());
+  for (std::size_t k = 0; k < cameras_.size(); ++k) {
+    const std::string p = frame_path(dir_, k, index);
+    frame.images[k] = std::filesystem::exists(p) ? cv::imread(p, cv::IMREAD_GRAYSCALE) : cv::Mat();
+    const Camera& c = cameras_[k];
+    if (!frame.images[k].empty() && (frame.images[k].cols != c.width || frame.images[k].rows != c.height))
+      frame.images[k] = cv::Mat();  // wrong size: not this camera's image
+  }
+  return true;
+}
+
+namespace {
+std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
+}  // namespace
+
+V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
+                       ReconnectPolicy policy)
+    : cameras_(std::move(cameras)), policy_(policy) {
+  crease::require_input(devices.size() == cameras_.size(),
+                        "camera_v4l2: " + std::to_string(devices.size()) + " devices for " +
+                            std::to_string(cameras_.size()) + " calibrations");
+  crease::require_input(devices.size() <= kMaxCameras, "camera_v4l2: " + std::to_string(devices.size()) +
+                                                           " devices, at most " + std::to_string(kMaxCameras));
+  crease::require_input(policy_.initial_s > 0.0 && policy_.max_s >= policy_.initial_s,
+                        "camera_v4l2: reconnect times must satisfy 0 < initial (" +
+                            std::to_string(policy_.initial_s) + " s) <= max (" + std::to_string(policy_.max_s) +
+                            " s)");
+  reconnects_ = std::make_unique<std::atomic<std::uint64_t>[]>(devices.size());
+  devices_.resize(devices.size());
+  const std::int64_t now = crease::rt::now_ns();
+  std::uint32_t dark = 0;
+  for (std::size_t k = 0; k < devices.size(); ++k) {
+    devices_[k].path = devices[k];
+    if (try_open(k)) continue;
+    failed_.push_back(devices[k]);
+    dark |= 1u << k;
+    went_dark(k, now);
+  }
+  dark_.store(dark, std::memory_order_release);
+}
+
+bool V4l2Source::try_open(std::size_t k) {
+  Device& d = devices_[k];
+  // Device nodes through V4L2; an image sequence pattern (dir/%06d.png) through OpenCV's image
+  // reader, which reads each file when grabbed (a missing file: the camera stopped); anything
+  // else (a video file) through whichever backend opens it.
+  const bool node = d.path.rfind("/dev/", 0) == 0;
+  const bool sequence = d.path.find('%') != std::string::npos;
+  try {
+    d.cap.open(d.path, node ? cv::CAP_V4L2 : sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
+    if (d.cap.isOpened() && node) {
+      d.cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
+      d.cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
+    }
+  } catch (const cv::Exception&) {
+    d.cap.release();  // unopenable now: retried later
+  }
+  d.open = d.cap.isOpened();
+  return d.open;
+}
+
+void V4l2Source::went_dark(std::size_t k, std::int64_t now_ns) {
+  Device& d = devices_[k];
+  d.cap.release();
+  d.open = false;
+  d.backoff_s = policy_.initial_s;
+  d.retry_at_ns = now_ns + seconds_to_ns(d.backoff_s);
+}
+
+bool V4l2Source::grab(Frame& frame) {
+  frame.index = next_++;
+  frame.images.resize(devices_.size());
+  const std::int64_t before = crease::rt::now_ns();
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    Device& d = devices_[k];
+    if (d.open || before < d.retry_at_ns) continue;
+    if (try_open(k)) {
+      reconnects_[k].fetch_add(1, std::memory_order_acq_rel);
+      total_reconnects_.fetch_add(1, std::memory_order_acq_rel);
+    } else {
+      d.retry_at_ns = before + seconds_to_ns(d.backoff_s);
+      d.backoff_s = std::min(2.0 * d.backoff_s, policy_.max_s);
+    }
+  }
+  // grab() all first so the exposures are as close in time as the devices allow.
+  std::vector<bool> ok(devices_.size());
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    try {
+      ok[k] = devices_[k].open && devices_[k].cap.grab();
+    } catch (const cv::Exception&) {
+      ok[k] = false;
+    }
+  }
+  frame.timestamp_ns = crease::rt::now_ns();
+  cv::Mat bgr;
+  std::uint32_t dark = 0;
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    Device& d = devices_[k];
+    frame.images[k] = cv::Mat();
+    bool read = ok[k];
+    try {
+      read = read && d.cap.retrieve(bgr) && !bgr.empty();
+    } catch (const cv::Exception&) {
+      read = false;
+    }
+    if (!read) {
+      if (d.open) went_dark(k, frame.timestamp_ns);  // stopped or disconnected: reopen later
+      dark |= 1u << k;
+      continue;
+    }
+    if (bgr.channels() == 3) cv::cvtColor(bgr, frame.images[k], cv::COLOR_BGR2GRAY);
+    else if (bgr.channels() == 1) frame.images[k] = bgr.clone();
+    const Camera& c = cameras_[k];
+    if (frame.images[k].cols != c.width || frame.images[k].rows != c.height) {
+      frame.images[k] = cv::Mat();  // delivers, but not this calibration's image
+      dark |= 1u << k;
+    }
+  }
+  dark_.store(dark, std::memory_order_release);
+  return true;  // live cameras do not end; a dark one delivers empty images until it is back
+}
+
+Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras) : dir_(dir), ncam_(cameras.size()) {
+  std::filesystem::create_directories(dir);
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    std::filesystem::create_directories(dir + "/cam" + std::to_string(k));
+    save_camera(cameras[k], dir + "/cam" + std::to_string(k) + ".yaml");
+  }
+  const std::string csv = dir + "/timestamps.csv";
+  stamps_ = std::fopen(csv.c_str(), "w");
+  if (stamps_ == nullptr) throw crease::Error(csv + ": cannot open for writing");
+  std::fprintf(stamps_, "frame,timestamp_ns\n");
+}
+
+Recorder::~Recorder() {
+  if (stamps_ != nullptr) std::fclose(stamps_);
+}
+
+void Recorder::write(const Frame& frame) {
+  for (std::size_t k = 0; k < ncam_ && k < frame.images.size(); ++k) {
+    if (frame.images[k].empty()) continue;
+    const std::string p = frame_path(dir_, k, frame.index);
+    if (!cv::imwrite(p, frame.images[k])) throw crease::Error(p + ": write failed");
+  }
+  std::fprintf(stamps_, "%" PRIu64 ",%" PRId64 "\n", frame.index, frame.timestamp_ns);
+  std::fflush(stamps_);
+}
+
+}  // namespace crease::vision

@@ -1,0 +1,134 @@
+// Camera sources: N synchronised grey images per frame from a recorded directory or live V4L2
+// devices (the simulated cameras' source, SimSource, is the simulated world's:
+// plugins/sim_world/scene/sim_source.h), and a recorder writing the replay layout:
+//   DIR/camK.yaml            calibration of camera K (camera_model.h format)
+//   DIR/camK/NNNNNN.png      frame NNNNNN of camera K (8-bit grey)
+//   DIR/timestamps.csv       "frame,timestamp_ns" header, one line per frame
+// A camera that delivers nothing this frame leaves its image empty; the others go on.
+// Not RT code (file and device I/O, OpenCV allocation): run it on a vision worker thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "plugins/camera_rig/camera_model.h"
+
+namespace crease::vision {
+
+struct Frame {
+  std::int64_t timestamp_ns = 0;
+  std::uint64_t index = 0;
+  std::vector<cv::Mat> images;  // one per camera, CV_8UC1; empty = nothing from that camera
+  // Set by the caller: images[k] are buffers of the right size to write into (a frame channel's
+  // set); a source that can fill them in place does (SimSource), instead of fresh buffers.
+  bool fill_in_place = false;
+};
+
+class CameraSource {
+ public:
+  virtual ~CameraSource() = default;
+  [[nodiscard]] virtual const std::vector<Camera>& cameras() const = 0;
+  // Fills the next frame; false at the end of a recording (or when no camera delivers).
+  virtual bool grab(Frame& frame) = 0;
+};
+
+// Reads a recorded directory. Throws crease::ConfigError naming the file on a missing or bad
+// calibration or timestamps.csv; a missing image is an empty image (that camera stopped).
+class ReplaySource final : public CameraSource {
+ public:
+  explicit ReplaySource(const std::string& dir);
+  [[nodiscard]] const std::vector<Camera>& cameras() const override { return cameras_; }
+  bool grab(Frame& frame) override;
+  [[nodiscard]] std::size_t frames() const { return stamps_.size(); }
+
+ private:
+  std::string dir_;
+  std::vector<Camera> cameras_;
+  std::vector<std::pair<std::uint64_t, std::int64_t>> stamps_;  // frame index, timestamp
+  std::size_t next_ = 0;
+};
+
+// How a live camera that did not open, or stopped delivering, is brought back: the capture
+// worker (inside grab()) retries opening it `initial_s` after the failure, doubling the wait
+// after each failed attempt up to `max_s` (seconds, CLOCK_MONOTONIC).
+struct ReconnectPolicy {
+  double initial_s = 0.5;
+  double max_s = 5.0;
+};
+
+// Live cameras through cv::VideoCapture; device k is cameras[k]. /dev/... opens with the V4L2
+// backend; an image sequence pattern (dir/%06d.png) with OpenCV's image reader (a file missing
+// when its turn comes is a camera that stopped); any other string (a video file) with whichever
+// backend OpenCV finds. A device that does not open or stops (grab/retrieve fails) is released and
+// reopened per the ReconnectPolicy; while it is dark, and when it delivers another image size,
+// its image is empty (the others go on). grab() never ends. A reopen attempt runs inside grab()
+// (a missing device fails at once; a device that came back delays that one frame by its open).
+class V4l2Source final : public CameraSource {
+ public:
+  static constexpr std::size_t kMaxCameras = 32;  // one bit each in dark_mask()
+  // Throws crease::ConfigError when devices and calibrations differ in number, there are more
+  // than kMaxCameras, or the policy is not 0 < initial_s <= max_s.
+  V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
+             ReconnectPolicy policy = {});
+  [[nodiscard]] const std::vector<Camera>& cameras() const override { return cameras_; }
+  bool grab(Frame& frame) override;
+  // The devices that did not open at construction.
+  [[nodiscard]] const std::vector<std::string>& failed_devices() const { return failed_; }
+  // Any thread (atomics). Bit k: camera k delivered nothing in the last grab (dark since
+  // construction until the first grab when it did not open).
+  [[nodiscard]] std::uint32_t dark_mask() const noexcept {
+    return dark_.load(std::memory_order_acquire);
+  }
+  // Any thread. Times camera k (or all cameras) opened again after failing to open or stopping.
+  [[nodiscard]] std::uint64_t reconnects(std::size_t k) const noexcept {
+    return k < cameras_.size() ? reconnects_[k].load(std::memory_order_acquire) : 0;
+  }
+  [[nodiscard]] std::uint64_t reconnects() const noexcept {
+    return total_reconnects_.load(std::memory_order_acquire);
+  }
+
+ private:
+  struct Device {
+    std::string path;
+    cv::VideoCapture cap;
+    bool open = false;
+    std::int64_t retry_at_ns = 0;  // next open attempt while closed
+    double backoff_s = 0;          // wait after the next failed attempt
+  };
+  bool try_open(std::size_t k);                   // true when it opened
+  void went_dark(std::size_t k, std::int64_t now_ns);  // release, retry after initial_s
+
+  std::vector<Camera> cameras_;
+  ReconnectPolicy policy_;
+  std::vector<Device> devices_;
+  std::vector<std::string> failed_;
+  std::unique_ptr<std::atomic<std::uint64_t>[]> reconnects_;
+  std::atomic<std::uint64_t> total_reconnects_{0};
+  std::atomic<std::uint32_t> dark_{0};
+  std::uint64_t next_ = 0;
+};
+
+// Writes frames in the replay layout (the `record` option of every source).
+class Recorder {
+ public:
+  Recorder(const std::string& dir, const std::vector<Camera>& cameras);
+  void write(const Frame& frame);
+
+ private:
+  std::string dir_;
+  std::size_t ncam_;
+  std::FILE* stamps_ = nullptr;
+
+ public:
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+};
+
+}  // namespace crease::vision

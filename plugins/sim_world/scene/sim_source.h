@@ -1,0 +1,39 @@
+// The simulated cameras: a CameraSource (plugins/cameras/camera_source.h) that renders, for every
+// calibrated camera of a ViewRenderer, the sheet mesh the scene holds for each frame. The
+// `camera_sim` plugin feeds it the `sheet_truth` port; tests and crease-bench give it meshes of
+// their own. Not RT code (rendering allocates): it runs on a camera worker thread.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "plugins/cameras/camera_source.h"
+#include "plugins/sim_world/scene/sheet_mesh.h"
+#include "plugins/sim_world/scene/view_renderer.h"
+
+namespace crease::vision {
+
+// Renders the mesh returned by `mesh_at(frame index)` for every camera; frame i is stamped with
+// the mesh's own time when it has one (SheetMesh::timestamp_ns >= 0, e.g. the simulated world's
+// truth), else start_ns + i * period_ns (pass the CLOCK_MONOTONIC start time in a running
+// system). Frame i's noise seed is options.seed + i.
+class SimSource final : public CameraSource {
+ public:
+  SimSource(std::shared_ptr<const ViewRenderer> renderer,
+            std::function<SheetMesh(std::uint64_t)> mesh_at, RenderOptions options,
+            std::int64_t period_ns, std::int64_t start_ns = 0);
+  [[nodiscard]] const std::vector<Camera>& cameras() const override { return renderer_->cameras(); }
+  bool grab(Frame& frame) override;  // never ends
+
+ private:
+  std::shared_ptr<const ViewRenderer> renderer_;
+  std::function<SheetMesh(std::uint64_t)> mesh_at_;
+  RenderOptions options_;
+  std::int64_t period_ns_;
+  std::int64_t start_ns_;
+  std::uint64_t next_ = 0;
+};
+
+}  // namespace crease::vision

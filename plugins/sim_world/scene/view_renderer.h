@@ -1,0 +1,54 @@
+// Synthetic camera views of the marker sheet: the face textures mapped onto a SheetMesh for
+// each calibrated camera, exact per pixel (ray / triangle intersection through the camera's
+// distortion), prefiltered by a texture pyramid, with shading, hand-like occluders, blur,
+// exposure and noise. Deterministic for a seed. Not RT code (it allocates on first use).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "plugins/camera_rig/camera_model.h"
+#include "plugins/sim_world/scene/sheet_mesh.h"
+
+namespace crease::vision {
+
+struct RenderOptions {
+  std::uint64_t seed = 1;
+  double noise_sigma = 2.0;    // Gaussian noise, grey levels
+  double blur_sigma_px = 0.6;  // optics; 0 = none
+  double exposure = 1.0;       // gain on scene radiance
+  int occluders = 0;           // hand-like occluders over the sheet
+  bool clutter = false;        // busy background (boxes, lines, code-like grids)
+};
+
+struct RenderedView {
+  cv::Mat image;           // CV_8UC1, camera size
+  cv::Mat occluder_mask;   // CV_8UC1, 255 where an occluder hides the scene
+  cv::Mat depth;           // CV_32FC1, camera-frame z of the sheet (mm), +inf elsewhere
+};
+
+class ViewRenderer {
+ public:
+  // front / back: CV_8UC1 textures in FRONT sheet coordinates (face_texture()), px_per_mm.
+  ViewRenderer(const cv::Mat& front, const cv::Mat& back, double tex_px_per_mm,
+               std::vector<Camera> cameras);
+
+  [[nodiscard]] const std::vector<Camera>& cameras() const { return cameras_; }
+  // Renders camera `cam` seeing `mesh`; the seed is mixed with the camera index.
+  void render(int cam, const SheetMesh& mesh, const RenderOptions& opt, RenderedView& out) const;
+
+ private:
+  std::vector<cv::Mat> front_pyr_, back_pyr_;  // CV_32F, level L halves level L-1
+  double ppm_;
+  std::vector<Camera> cameras_;
+  std::vector<cv::Mat> rays_;  // per camera CV_32FC2: undistorted normalized (x, y) per pixel
+};
+
+// A random busy scene with no tag of `layout_ids` (for false-positive tests): boxes, lines,
+// text, checkerboards, random bit grids with a black border and tags of other ids / other
+// dictionaries. Deterministic for a seed.
+cv::Mat render_clutter(int width, int height, std::uint64_t seed, int max_layout_id);
+
+}  // namespace crease::vision
