@@ -1,6 +1,7 @@
 // The common part of the camera source plugins (camera_sim, camera_replay, camera_v4l2):
 // a CameraSource on a CameraWorker publishing into the frame channel of the `images` port
-// (images_port.h), and the `frames` port (crease::CameraFrames) announcing each published set.
+// (plugins/camera_rig/images_port.h), and the `frames` port (crease::CameraFrames) announcing
+// each published set.
 // Compiled into each camera plugin library (header-only: plugins share no code at run time
 // except through core).
 //

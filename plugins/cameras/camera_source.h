@@ -1,7 +1,7 @@
 // Camera sources: N synchronised grey images per frame from a recorded directory or live V4L2
 // devices (the simulated cameras' source, SimSource, is the simulated world's:
 // plugins/sim_world/scene/sim_source.h), and a recorder writing the replay layout:
-//   DIR/camK.yaml            calibration of camera K (camera_model.h format)
+//   DIR/camK.yaml            calibration of camera K (plugins/camera_rig/camera_model.h format)
 //   DIR/camK/NNNNNN.png      frame NNNNNN of camera K (8-bit grey)
 //   DIR/timestamps.csv       "frame,timestamp_ns" header, one line per frame
 // A camera that delivers nothing this frame leaves its image empty; the others go on.

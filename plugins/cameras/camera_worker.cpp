@@ -11,7 +11,8 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
                            std::shared_ptr<crease::frames::FrameChannel> channel,
                            const std::string& record_dir)
     : source_(std::move(source)), channel_(std::move(channel)) {
-  // The plugin bound the channel with these cameras (images_port.h): the registry checked them.
+  // The plugin bound the channel with these cameras (plugins/camera_rig/images_port.h): the
+  // registry checked them.
   CREASE_DEMAND(channel_->cameras() == channel_specs(source_->cameras()),
                 "the frame channel does not have this source's cameras");
   if (!record_dir.empty()) recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras());

@@ -11,7 +11,7 @@ namespace crease::sheet {
 
 // A regular grid of square markers, centred in equal cells of the sheet: only what the
 // key-points' sheet positions need. The printed layout the cameras detect (ids, faces, the
-// dictionary, a layout file) is vision::MarkerLayout (plugins/vision/marker_layout.h).
+// dictionary, a layout file) is vision::MarkerLayout (plugins/camera_rig/marker_layout.h).
 struct SyntheticMarkerGrid {
   int cols = 5, rows = 7;
   double width_mm = 210, height_mm = 297;

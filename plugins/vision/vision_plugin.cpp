@@ -1,10 +1,11 @@
 // Plugin `vision`: marker detection and N-view triangulation of the frame sets a camera source
-// plugin (camera_sim, camera_replay, camera_v4l2) publishes -> `keypoints` port.
-// The images come through the frame channel of the `images` port (images_port.h, kind
-// `frames`), not through a latest port: five 1280x960 images are 6 MB a set. The `frames`
-// port (crease::CameraFrames) carries the source's announcement. Detection and triangulation run on a worker thread woken by each
-// publish (VisionWorker); update() only copies the newest key-points out: no allocation, no
-// lock, no wait.
+// plugin (plugins/cameras: camera_sim, camera_replay, camera_v4l2) publishes -> `keypoints` port.
+// The images come through the frame channel of the `images` port
+// (plugins/camera_rig/images_port.h, kind `frames`), not through a latest port: five 1280x960
+// images are 6 MB a set. The `frames` port (crease::CameraFrames) carries the source's
+// announcement. Detection and triangulation run on a worker thread woken by each publish
+// (VisionWorker); update() only copies the newest key-points out: no allocation, no lock, no
+// wait.
 //
 // Parameters (paths relative to the configuration file's folder):
 //   cameras: DIR of cam0.yaml.. (the calibrations of the channel's cameras, in order; for a

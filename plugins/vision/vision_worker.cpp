@@ -14,7 +14,8 @@ VisionWorker::VisionWorker(std::shared_ptr<crease::frames::FrameChannel> channel
       pipeline_(cameras, layout, det, tri, camera_threads),
       result_(std::make_unique<crease::Keypoints>()),
       images_(cameras.size()) {
-  // The plugin bound the channel with these cameras (images_port.h): the registry checked them.
+  // The plugin bound the channel with these cameras (plugins/camera_rig/images_port.h): the
+  // registry checked them.
   CREASE_DEMAND(channel_->cameras() == channel_specs(cameras), "the frame channel does not have these cameras");
   reader_ = channel_->try_claim_reader();
   thread_ = std::thread([this] { run(); });

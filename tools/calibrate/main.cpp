@@ -1,4 +1,5 @@
-// crease-calibrate: camera calibration files (OpenCV FileStorage YAML, see camera_model.h).
+// crease-calibrate: camera calibration files (OpenCV FileStorage YAML, see
+// plugins/camera_rig/camera_model.h).
 //   crease-calibrate board --out board.png [--dpi 300]          printable ChArUco board
 //   crease-calibrate intrinsics --out camK.yaml IMAGE...           intrinsics from board views
 //   crease-calibrate extrinsics --out DIR --intrinsics cam0.yaml... --images img0.png...

@@ -121,7 +121,8 @@ TEST_CASE("camera_sim refuses its removed fold parameters with the file, line an
       CAPTURE(what);
       // Line 3, at the key's value (column after "KEY: ").
       const std::string where = "config/test.yaml:3:" + std::to_string(key.size() + 3) + ": ";
-      CHECK(what.find(where + "cameras.params." + key + ": unknown parameter") != std::string::npos);
+      CHECK(what.find(where + "cameras.params." + key + ": unknown parameter") !=
+            std::string::npos);
     }
   }
 }

@@ -149,7 +149,8 @@ TEST_CASE("a new worker waits for the old one's writer end (hot swap), then publ
 }
 
 TEST_CASE("a channel with other cameras than the source's is a bug: the worker aborts") {
-  // Plugins get the channel from the port registry, which checked the cameras (images_port.h).
+  // Plugins get the channel from the port registry, which checked the cameras
+  // (plugins/camera_rig/images_port.h).
   crease::vision::testing::Scene s;
   auto ch = std::make_shared<crease::frames::FrameChannel>(
       "camera_worker_test.other", std::vector<crease::frames::CameraSpec>{{"a", 320, 240}});

@@ -1,8 +1,8 @@
 // The camera source plugins (plugins/cameras: camera_replay, camera_sim on the sheet_truth
-// plugin's sheet, camera_v4l2) feeding the `vision` plugin in a real loop: key-points on the `keypoints` port, frame sets through one frame
-// channel (the host's port of kind frames that both dlopen'd plugins bound, listed with the
-// other ports); degraded, never stopped, when a camera stops; a replay processed twice gives
-// the same key-points; either end hot-swapped.
+// plugin's sheet, camera_v4l2) feeding the `vision` plugin in a real loop: key-points on the
+// `keypoints` port, frame sets through one frame channel (the host's port of kind frames that
+// both dlopen'd plugins bound, listed with the other ports); degraded, never stopped, when a
+// camera stops; a replay processed twice gives the same key-points; either end hot-swapped.
 #include <doctest/doctest.h>
 
 #include <chrono>

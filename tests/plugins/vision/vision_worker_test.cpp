@@ -87,7 +87,8 @@ TEST_CASE("each published set is detected once, without allocating on the RT sid
 }
 
 TEST_CASE("calibrations that do not match the channel are a bug; a worker releases its reader end") {
-  // Plugins get the channel from the port registry, which checked the cameras (images_port.h).
+  // Plugins get the channel from the port registry, which checked the cameras
+  // (plugins/camera_rig/images_port.h).
   crease::vision::testing::Scene s;
   auto ch = std::make_shared<crease::frames::FrameChannel>("vision_worker_test.b",
                                                            channel_specs(small_rig()));
