@@ -9,6 +9,7 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Real-time plugin framework for a paper-fo
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGING_INSTALL_PREFIX /opt/crease)
+set(CPACK_INSTALL_PREFIX /opt/crease)  # with CPACK_SET_DESTDIR, the prefix cpack installs under
 # Absolute destinations (/etc/crease, /lib/systemd/system) land in the package, not on the host.
 set(CPACK_SET_DESTDIR ON)
 set(CPACK_STRIP_FILES ON)

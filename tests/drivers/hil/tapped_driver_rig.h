@@ -34,11 +34,11 @@ struct TappedDriverRig {
   using Test = typename drivers::testing::CommandTap<WireCommand>::Test;
   // tag names the bus (made unique per process); the driver is `instance` of `library`.
   TappedDriverRig(const std::string& tag, std::uint8_t node, const char* instance, const char* library,
-                  const char* state_port, const char* command_port, Test match, Test zero)
+                  const char* state_port, const char* command_port, Test match, Test zero, Test safe)
       : bus(tag + "-" + std::to_string(::getpid())),
         broker({bus, 1'000'000, 5'000'000, false}),
         dev_bus({bus, node, 1'000'000, 5'000'000}),
-        tap(dev_bus, node, match, zero),
+        tap(dev_bus, node, match, zero, safe),
         device(tap, config_for(node)),
         thread(dev_bus.fd(), [this](std::int64_t t) { device.step(t); }),
         rig(instance, library, state_port) {

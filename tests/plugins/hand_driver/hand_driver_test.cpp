@@ -74,6 +74,9 @@ bool all_zero(const dr::hand::Command& c) {
     if (std::fabs(t) > 1e-4f) return false;
   return true;
 }
+// A frame of the driver's safe state: the hand disabled (hold position, zero force), sent when
+// the link's watchdog tripped on a stalled machine.
+bool safe_frame(const dr::hand::Command& c) { return (c.flags & dr::hand::kCmdEnable) == 0; }
 HandCommand command_with(float offset) {
   HandCommand c;
   c.enable = 1;
@@ -92,21 +95,23 @@ bool link_ok(const HandState& s) { return s.health == DeviceHealth::ok; }
 // every cycle after it (the driver must not fall back to a default, all-zero command on the
 // cycles when nothing new arrived).
 TEST_CASE("hand_driver: a command written once is held unchanged, frame after frame, for 1000 cycles") {
-  HoldRig r("plug-hand-hold", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero);
+  HoldRig r("plug-hand-hold", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero, &safe_frame);
   auto& tap = r.tap;
   r.start_with(&link_ok, command_with(0.0f));
-  const auto start = tap.total.load();
-  REQUIRE(eventually([&] { return tap.total.load() >= start + 1000; }));
+  const auto start = tap.matching.load();
+  // 1000 commanding frames (safe-state frames of a stalled machine are counted apart).
+  REQUIRE(eventually([&] { return tap.matching.load() >= start + 1000; }));
   r.rig.host.stop();
   CHECK(tap.matching.load() >= 1000);
   CHECK(tap.differing.load() == 0);
   CHECK(tap.zeros.load() == 0);
+  CHECK(tap.safe.load() * 2 < tap.matching.load());  // gross: a stalled machine's few, not a broken hold
 }
 
 // A 60 Hz writer (the model loop's rate) feeding the 1 kHz driver: ~16 driver cycles per
 // command; none of them may send a zero command once the first command arrived.
 TEST_CASE("hand_driver: a 60 Hz command writer never produces a zero command frame at 1 kHz") {
-  HoldRig r("plug-hand-60", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero);
+  HoldRig r("plug-hand-60", 1, "hand_r", "hand_driver", "hand_state", "hand_command", &matches_held, &all_zero, &safe_frame);
   auto& tap = r.tap;
   r.start_with(&link_ok, command_with(0.0f));
   // Paced by the frames the device sees, not by the wall clock (a loaded machine stretches
