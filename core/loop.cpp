@@ -14,6 +14,7 @@ rt::PeriodicLoop::Settings thread_settings(const LoopSpec& s) {
   t.period_ns = static_cast<std::int64_t>(std::llround(1e9 / s.rate_hz));
   t.thread.priority = s.priority;
   t.thread.cpu = s.cpu;
+  t.phase_ns = s.phase_ns;
   return t;
 }
 

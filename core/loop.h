@@ -37,6 +37,7 @@ struct LoopSpec {
   double rate_hz = 1000.0;
   int priority = 0;  // 0 = SCHED_OTHER, 1..99 = SCHED_FIFO
   int cpu = -1;      // -1 = any
+  std::int64_t phase_ns = 0;  // deadlines at k period + phase_ns of CLOCK_MONOTONIC, [0, period)
 };
 
 struct Schedule {

@@ -1,5 +1,7 @@
 #include "core/plugin_host.h"
 
+#include <cmath>
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -69,6 +71,8 @@ Loop& PluginHost::add_loop(const LoopSpec& spec) {
   std::lock_guard lock(mu_);
   if (find_loop(spec.name) != nullptr) throw ConfigError("loop '" + spec.name + "' is defined twice");
   if (!(spec.rate_hz > 0.0)) throw ConfigError("loop '" + spec.name + "': rate must be positive");
+  if (spec.phase_ns < 0 || spec.phase_ns >= static_cast<std::int64_t>(std::llround(1e9 / spec.rate_hz)))
+    throw ConfigError("loop '" + spec.name + "': phase must be in [0, period)");
   loops_.push_back(std::make_unique<Loop>(spec));
   Loop& loop = *loops_.back();
   if (running_) {

@@ -12,8 +12,9 @@ namespace crease::rt {
 
 PeriodicLoop::PeriodicLoop(Settings settings, Body body, void* ctx)
     : settings_(std::move(settings)), body_(body), ctx_(ctx) {
-  if (settings_.period_ns <= 0 || body_ == nullptr) {
-    std::fprintf(stderr, "crease: PeriodicLoop '%s' needs a positive period and a body\n", settings_.name.c_str());
+  if (settings_.period_ns <= 0 || body_ == nullptr || settings_.phase_ns < 0 || settings_.phase_ns >= settings_.period_ns) {
+    std::fprintf(stderr, "crease: PeriodicLoop '%s' needs a positive period, a phase in [0, period) and a body\n",
+                 settings_.name.c_str());
     std::abort();
   }
 }
@@ -43,7 +44,10 @@ void PeriodicLoop::run_thread() {
 
   mark_this_thread_rt(true);
   const std::int64_t period = settings_.period_ns;
-  std::int64_t deadline = now_ns() + period;
+  // The first grid point at least one period ahead.
+  const std::int64_t earliest = now_ns() + period;
+  std::int64_t deadline = earliest - (earliest - settings_.phase_ns) % period;
+  if (deadline < earliest) deadline += period;
   timing_.started_ns.store(deadline, std::memory_order_relaxed);
   std::uint64_t cycle = 0;
   std::int64_t previous_wake = 0;

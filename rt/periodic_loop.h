@@ -49,6 +49,10 @@ class PeriodicLoop {
     std::string name;
     std::int64_t period_ns = 1'000'000;
     ThreadSettings thread;
+    // Deadlines lie on the period's grid of CLOCK_MONOTONIC shifted by this, in [0, period):
+    // t = k period + phase_ns. Loops of one rate keep a fixed phase to each other (a loop that
+    // answers another's frames runs phase_ns after it, as a shifted EtherCAT SYNC0 would).
+    std::int64_t phase_ns = 0;
   };
 
   PeriodicLoop(Settings settings, Body body, void* ctx);

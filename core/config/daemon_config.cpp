@@ -134,7 +134,7 @@ void read_loops(const MapReader& root, DaemonConfig& cfg) {
   }
   for (std::size_t i = 0; i < loops.size(); ++i) {
     const MapReader m(f, loops[i], index_path("loops", i),
-                      {"name", "rate_hz", "priority", "cpu", "overrun"});
+                      {"name", "rate_hz", "priority", "cpu", "phase_us", "overrun"});
     LoopConfig loop;
     loop.loc = m.loc();
     loop.name = read_identifier(f, m.require("name"), m.path_of("name"));
@@ -150,6 +150,15 @@ void read_loops(const MapReader& root, DaemonConfig& cfg) {
     loop.priority = static_cast<int>(read_int(f, m.require("priority"), m.path_of("priority"), 0, 99));
     if (m.has("cpu")) {
       loop.cpu = static_cast<int>(read_int(f, m.get("cpu"), m.path_of("cpu"), -1, 1023));
+    }
+    if (m.has("phase_us")) {
+      const double period_us = 1e-3 * static_cast<double>(loop.period_ns());
+      const double phase_us = read_number(f, m.get("phase_us"), m.path_of("phase_us"), 0.0, period_us, false);
+      if (!(phase_us < period_us)) {
+        throw ConfigError(loc_of(f, m.get("phase_us")), m.path_of("phase_us"),
+                          "must be below the loop's period (" + std::to_string(std::llround(period_us)) + " us)");
+      }
+      loop.phase_ns = static_cast<std::int64_t>(std::llround(phase_us * 1e3));
     }
     if (m.has("overrun")) {
       const std::string o = read_string(f, m.get("overrun"), m.path_of("overrun"));

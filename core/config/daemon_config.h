@@ -49,6 +49,7 @@ struct LoopConfig {
   double rate_hz = 0; // (0, 20000]
   int priority = 0;   // 0 = SCHED_OTHER, 1..99 = SCHED_FIFO
   int cpu = -1;       // -1 = any, else 0..1023
+  std::int64_t phase_ns = 0;  // phase_us: deadlines at k period + phase of CLOCK_MONOTONIC, [0, period)
   OverrunPolicy overrun = OverrunPolicy::skip;
   SourceLoc loc;
 

@@ -53,7 +53,7 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
     if (e.type == HostEvent::Type::fault) return;  // the host logs faults itself
     spdlog::info("{} '{}' in loop '{}'{}{}", to_string(e.type), e.instance, e.loop, e.detail.empty() ? "" : ": ", e.detail);
   });
-  for (const auto& l : config_.loops) host_->add_loop({l.name, l.rate_hz, l.priority, l.cpu});
+  for (const auto& l : config_.loops) host_->add_loop({l.name, l.rate_hz, l.priority, l.cpu, l.phase_ns});
   for (std::size_t i = 0; i < config_.plugins.size(); ++i) {
     const auto& p = config_.plugins[i];
     try {

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/port_types/payload_layout.h"
+
 namespace crease {
 
 struct WorldFingertip {
@@ -62,5 +64,7 @@ struct WorldState {
     return std::isfinite(sheet_table_contact_area_mm2) && std::isfinite(time_s);
   }
 };
+
+CREASE_PORT_PAYLOAD_LAYOUT(WorldState, 1120, 8);
 
 }  // namespace crease

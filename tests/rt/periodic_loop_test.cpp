@@ -55,6 +55,35 @@ TEST_CASE("a 1 kHz loop runs at its rate, on an RT-marked thread, and stops") {
   CHECK(loop.timing().period.count() == runs - 1);
 }
 
+namespace {
+struct Deadlines {
+  std::atomic<std::uint64_t> runs{0};
+  std::int64_t deadline[64] = {};
+};
+void record_deadline(void* ctx, const crease::rt::CycleClock& c) noexcept {
+  auto* d = static_cast<Deadlines*>(ctx);
+  const auto n = d->runs.load(std::memory_order_relaxed);
+  if (n < 64) d->deadline[n] = c.deadline_ns;
+  d->runs.store(n + 1, std::memory_order_release);
+}
+}  // namespace
+
+TEST_CASE("deadlines lie on the period's grid, shifted by the phase: two loops of one rate keep it") {
+  Deadlines a, b;
+  crease::rt::PeriodicLoop::Settings sa{"grid0", 1'000'000, {}}, sb{"grid300", 1'000'000, {}};
+  sb.phase_ns = 300'000;
+  crease::rt::PeriodicLoop la(sa, &record_deadline, &a), lb(sb, &record_deadline, &b);
+  la.start();
+  lb.start();
+  while (a.runs.load() < 20 || b.runs.load() < 20) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  la.stop();
+  lb.stop();
+  for (int i = 0; i < 20; ++i) {
+    CHECK(a.deadline[i] % 1'000'000 == 0);
+    CHECK(b.deadline[i] % 1'000'000 == 300'000);
+  }
+}
+
 TEST_CASE("an overrun skips the missed periods instead of replaying them") {
   Recorder rec;
   rec.busy_on_cycle = 20;

@@ -115,6 +115,15 @@ TEST_CASE("a complete configuration loads into plain structs with resolved paths
   CHECK(c.safety.max_overruns_per_s == doctest::Approx(5.0));
 }
 
+TEST_CASE("a loop's phase: its deadlines' offset on its period's grid, in ns") {
+  const cfg::DaemonConfig c = cfg::load_daemon_config_from_string(
+      "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: 1000, priority: 0}\n"
+      "  - {name: b, rate_hz: 1000, priority: 0, phase_us: 500}\n",
+      "x.yaml", kNoDirCheck);
+  CHECK(c.loops[0].phase_ns == 0);
+  CHECK(c.loops[1].phase_ns == 500'000);
+}
+
 TEST_CASE("defaults: optional sections may be absent") {
   const cfg::DaemonConfig c = cfg::load_daemon_config_from_string(
       "plugin_dirs: [p]\nloops: [{name: a, rate_hz: 10, priority: 0}]\n", "x.yaml", kNoDirCheck);
@@ -199,6 +208,10 @@ TEST_CASE("bad configurations name file, line, column, key and reason") {
        "/etc/crease/bad.yaml:12:20: plugins[0].params.pid.kp: duplicate key 'kp'"},
       {"nan rate", "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: .nan, priority: 1}\n",
        "/etc/crease/bad.yaml:3:24: loops[0].rate_hz: expected a finite number, got '.nan'"},
+      {"phase of a whole period", "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: 1000, priority: 1, phase_us: 1000}\n",
+       "/etc/crease/bad.yaml:3:53: loops[0].phase_us: must be below the loop's period (1000 us)"},
+      {"negative phase", "plugin_dirs: [p]\nloops:\n  - {name: a, rate_hz: 1000, priority: 1, phase_us: -1}\n",
+       "/etc/crease/bad.yaml:3:53: loops[0].phase_us: must be in [0, 1000], got -1"},
   };
   static_assert(sizeof(cases) / sizeof(cases[0]) >= 15);
   for (const Case& c : cases) {
