@@ -7,6 +7,8 @@ namespace crease::drivers::sim {
 SimArm::SimArm(CanBus& bus, const SimArmConfig& cfg) noexcept
     : CanopenDevice(bus, cfg.node, cfg.watchdog_ns, cfg.heartbeat_period_ns, cfg.auto_start), cfg_(cfg) {
   drive_.power_up();
+  for (int j = 0; j < arm::kJoints; ++j) pos_[j] = pos_sp_[j] = cfg.initial_position_rad[j];
+  publish();
 }
 
 void SimArm::on_pdo(const CanFrame& f, std::int64_t now_ns) noexcept {

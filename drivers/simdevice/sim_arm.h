@@ -18,6 +18,7 @@ struct SimArmConfig {
   std::int64_t watchdog_ns = 20'000'000;
   std::int64_t heartbeat_period_ns = 100'000'000;
   bool auto_start = false;
+  float initial_position_rad[arm::kJoints] = {};  // where the joints are at power-up
 };
 
 using SimArmCounters = SimDeviceCounters;

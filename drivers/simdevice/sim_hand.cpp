@@ -29,9 +29,14 @@ void SimHand::on_pdo(const CanFrame& f, std::int64_t now_ns) noexcept {
   }
 }
 
+void SimHand::set_joint_positions(const float (&rad)[hand::kJoints]) noexcept {
+  for (int j = 0; j < hand::kJoints; ++j) pos_[j] = rad[j];
+}
+
 void SimHand::integrate(std::int64_t now_ns) noexcept {
   const double dt = static_cast<double>(now_ns - last_step_ns_) * 1e-9;
   last_step_ns_ = now_ns;
+  if (cfg_.external_positions) return;        // the world moves the joints
   if (dt <= 0 || safe_ || !enabled_) return;  // safe state: hold position, zero force
   const double a = 1.0 - std::exp(-dt / cfg_.tau_s);
   for (int j = 0; j < hand::kJoints; ++j) {

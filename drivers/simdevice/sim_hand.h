@@ -2,7 +2,10 @@
 // dynamics: each joint tracks its target with a first-order lag (time constant tau_s);
 // an external joint torque deflects it by torque / stiffness; in the safe state (20 ms
 // without a valid command, or flag enable = 0) it holds its position with zero stiffness.
-// The CANopen services and step() come from CanopenDevice.
+// With external_positions (a simulated world owns the hand's physics, plugins/sim_world) the
+// device has no dynamics of its own: its status frames report the joint angles the world set
+// (set_joint_positions), and the world reads what the host commanded (target, stiffness,
+// limp). The CANopen services and step() come from CanopenDevice.
 #pragma once
 
 #include <atomic>
@@ -19,6 +22,7 @@ struct SimHandConfig {
   std::int64_t watchdog_ns = 20'000'000;   // no valid command for this long -> safe state
   std::int64_t heartbeat_period_ns = 100'000'000;
   bool auto_start = false;                 // enter operational without an NMT start
+  bool external_positions = false;         // positions from set_joint_positions, no own dynamics
 };
 
 using SimHandCounters = SimDeviceCounters;
@@ -29,6 +33,14 @@ class SimHand final : public CanopenDevice {
   // World inputs (any thread): external torque on a joint (N m), fingertip pressures (kPa).
   void set_external_torque(int joint, float torque_nm) noexcept { ext_torque_[joint].store(torque_nm); }
   void set_pressure(int sensor, float kpa) noexcept { pressure_[sensor].store(kpa); }
+  // The world's side of external_positions, from the thread that calls step() (between two
+  // steps): the joint angles the next status frames report (rad), and what the host commands:
+  // targets (rad), stiffness (N m/rad, the last stiffness frame; 5 until one arrived), and
+  // whether the hand is limp (safe state or not enabled: hold where it is, zero force).
+  void set_joint_positions(const float (&rad)[hand::kJoints]) noexcept;
+  [[nodiscard]] float commanded_target(int j) const noexcept { return target_[j]; }
+  [[nodiscard]] float commanded_stiffness(int j) const noexcept { return stiffness_[j]; }
+  [[nodiscard]] bool limp() const noexcept { return safe_ || !enabled_; }
   // Observers for tests and the world (any thread): published at the end of every step().
   [[nodiscard]] bool in_safe_state() const noexcept { return safe_pub_.load(); }
   [[nodiscard]] canopen::NmtState nmt() const noexcept { return nmt_pub_.load(); }
