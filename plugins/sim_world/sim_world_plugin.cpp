@@ -1,0 +1,143 @@
+// Plugin `sim_world`: the simulated world (sim_world.h: the robot of config/robot/, compliant
+// hands, a physical sheet on the table) and the simulated robot's hardware it moves (the mocked
+// CAN FD buses and the two hands and two arms of drivers/simdevice), stepped in lockstep from
+// this plugin's update, one 1 ms world step per cycle (world_devices.h). Put it in a 1 kHz
+// loop of its own, phased half a period after the control loop (`phase_us: 500`) so that the
+// SYNC the drivers send in their write phase is answered before their next update; never in
+// the control loop (a step costs about a fifth of a period).
+//   output world_state  (latest WorldState: fingertips, contact forces, joint angles, counters)
+//   output sheet_truth  (latest SheetState: the world's sheet, every truth_every_steps steps)
+// The devices answer on `<bus_prefix>-hand_r`, `-hand_l`, `-arm_r`, `-arm_l` as sim_devices'
+// do (this plugin takes its place; the drivers' parameters are the same). Parameters:
+// world_config.h and README.md.
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "core/plugin.h"
+#include "core/port_types/sheet_state.h"
+#include "core/port_types/world_state.h"
+#include "plugins/robot_model/robot_model.h"
+#include "plugins/sim_world/randomise.h"
+#include "plugins/sim_world/sim_world.h"
+#include "plugins/sim_world/world_config.h"
+#include "plugins/sim_world/world_devices.h"
+
+namespace {
+
+using namespace crease;
+namespace wd = crease::world;
+
+class SimWorldPlugin final : public Plugin {
+ public:
+  void configure(const Params& p, PortBinder& ports) override {
+    cfg_ = wd::read_world_config(p);
+    try {
+      robot_ = std::make_unique<robot::RobotModel>(robot::RobotModel::load(cfg_.robot_yaml));
+    } catch (const std::exception& e) {
+      p.fail("robot", e.what());
+    }
+    try {
+      world_ = std::make_unique<wd::World>(*robot_, cfg_.world);
+    } catch (const std::exception& e) {
+      p.fail("", std::string("the world cannot be built: ") + e.what());
+    }
+    drivers::sim::SimRobotConfig rc;
+    rc.prefix = cfg_.bus_prefix;
+    rc.bitrate = cfg_.bitrate;
+    rc.data_bitrate = cfg_.data_bitrate;
+    try {
+      devices_ = std::make_unique<wd::WorldDevices>(*world_, rc);
+    } catch (const std::exception& e) {
+      p.fail("bus_prefix", std::string("cannot create the mocked buses: ") + e.what() +
+                               " (is another simulated robot running with this prefix?)");
+    }
+    full_ = std::make_unique<SheetState>();
+    if (cfg_.truth_stride > 1) truth_ = std::make_unique<SheetState>();
+    state_ = std::make_unique<WorldState>();
+    world_out_ = ports.latest_output<WorldState>("world_state", WorldState{});
+    const auto no_sheet = std::make_unique<SheetState>();  // the safe value: no sheet (0 x 0 nodes)
+    sheet_out_ = ports.latest_output<SheetState>("sheet_truth", *no_sheet);
+    log_draws();
+  }
+
+  void activate() override { steps_ = 0; }
+
+  Status update(const Cycle& cycle) override {
+    devices_->step_rt();
+    *state_ = world_->state();
+    state_->timestamp_ns = cycle.time_ns;  // the port's stamp: the loop's clock
+    world_out_.write(*state_, cycle.time_ns);
+    if (steps_++ % static_cast<std::uint64_t>(cfg_.truth_every_steps) == 0) publish_sheet(cycle.time_ns);
+    return Status::ok;
+  }
+
+  void cleanup() override {
+    devices_.reset();  // the devices and their buses first: they reference the world
+    world_.reset();
+    robot_.reset();
+  }
+
+ private:
+  void publish_sheet(std::int64_t now_ns) noexcept {
+    world_->export_sheet_rt(*full_);
+    full_->timestamp_ns = now_ns;
+    if (!truth_) {
+      sheet_out_.write(*full_, now_ns);
+      return;
+    }
+    // Every stride-th node in u and v: the coarser grid's nodes are the finer grid's.
+    const int k = cfg_.truth_stride, W = full_->nodes_u, H = full_->nodes_v;
+    SheetState& t = *truth_;
+    t.timestamp_ns = now_ns;
+    t.step = full_->step;
+    t.nodes_u = static_cast<std::uint16_t>((W - 1) / k + 1);
+    t.nodes_v = static_cast<std::uint16_t>((H - 1) / k + 1);
+    t.width_mm = full_->width_mm;
+    t.height_mm = full_->height_mm;
+    t.link_count = 0;  // the world's links are not the coarse grid's
+    t.crease_count = 0;
+    t.fit_error_mm = full_->fit_error_mm;
+    t.observations = 0;
+    t.rollbacks = full_->rollbacks;
+    for (int j = 0; j < t.nodes_v; ++j) {
+      for (int i = 0; i < t.nodes_u; ++i) {
+        const int from = j * k * W + i * k, to = j * t.nodes_u + i;
+        std::memcpy(t.position_mm[to], full_->position_mm[from], sizeof t.position_mm[to]);
+        std::memcpy(t.normal[to], full_->normal[from], sizeof t.normal[to]);
+      }
+    }
+    sheet_out_.write(t, now_ns);
+  }
+
+  // The seed and its draws, in lines the RT log carries (96 characters each).
+  void log_draws() const {
+    const std::string line = wd::describe(cfg_.world.seed, world_->draws());
+    std::size_t at = 0;
+    while (at < line.size()) {
+      std::size_t n = std::min<std::size_t>(90, line.size() - at);
+      if (at + n < line.size()) {
+        const std::size_t cut = line.rfind(", ", at + n);
+        if (cut != std::string::npos && cut > at) n = cut + 2 - at;
+      }
+      log_rt(rt::LogLevel::info, line.substr(at, n).c_str());
+      at += n;
+    }
+  }
+
+  wd::WorldPluginConfig cfg_;
+  std::unique_ptr<robot::RobotModel> robot_;
+  std::unique_ptr<wd::World> world_;
+  std::unique_ptr<wd::WorldDevices> devices_;
+  std::unique_ptr<SheetState> full_, truth_;
+  std::unique_ptr<WorldState> state_;
+  LatestOutput<WorldState> world_out_;
+  LatestOutput<SheetState> sheet_out_;
+  std::uint64_t steps_ = 0;
+};
+
+}  // namespace
+
+CREASE_PLUGIN(SimWorldPlugin, "sim_world", "1.0.0")

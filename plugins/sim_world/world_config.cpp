@@ -1,0 +1,80 @@
+#include "plugins/sim_world/world_config.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "drivers/host/bus_prefix.h"
+
+namespace crease::world {
+namespace {
+
+constexpr double kRad = std::numbers::pi / 180.0;
+
+// A list of N numbers in degrees under KEY (absent: FALLBACK), as radians.
+template <std::size_t N>
+std::array<double, N> read_angles_deg(const Params& p, const char* key, const double (&fallback)[N]) {
+  std::array<double, N> out{};
+  if (!p.has(key)) {
+    for (std::size_t i = 0; i < N; ++i) out[i] = fallback[i] * kRad;
+    return out;
+  }
+  const YAML::Node n = p.raw(key);
+  if (!n.IsSequence() || n.size() != N) p.fail(key, "expected a list of " + std::to_string(N) + " angles in degrees");
+  for (std::size_t i = 0; i < N; ++i) {
+    double v = 0;
+    try {
+      v = n[i].as<double>();
+    } catch (const YAML::Exception&) {
+      p.fail(key, "element " + std::to_string(i) + " is not a number");
+    }
+    if (!std::isfinite(v) || std::fabs(v) > 360.0) p.fail(key, "element " + std::to_string(i) + " must be in [-360, 360] deg");
+    out[i] = v * kRad;
+  }
+  return out;
+}
+
+}  // namespace
+
+WorldPluginConfig read_world_config(const Params& p) {
+  WorldPluginConfig c;
+  c.robot_yaml = p.get_path("robot");
+  WorldParams& w = c.world;
+  w.seed = static_cast<std::uint64_t>(p.get_in_range<long long>("seed", 1, 0, (1LL << 62)));
+  w.randomise = p.get<bool>("randomise", true);
+  w.sheet_offset_mm = p.get_in_range<double>("sheet_offset_mm", w.sheet_offset_mm, 0.0, 100.0);
+  w.sheet_yaw_deg = p.get_in_range<double>("sheet_yaw_deg", w.sheet_yaw_deg, 0.0, 90.0);
+  w.stiffness_fraction = p.get_in_range<double>("stiffness_fraction", w.stiffness_fraction, 0.0, 0.5);
+  w.yield_fraction = p.get_in_range<double>("yield_fraction", w.yield_fraction, 0.0, 0.5);
+  w.friction_fraction = p.get_in_range<double>("friction_fraction", w.friction_fraction, 0.0, 0.5);
+  sheet::GridParams& g = w.sheet.grid;
+  g.nodes_u = p.get_in_range<int>("nodes_u", g.nodes_u, 3, 64);
+  g.nodes_v = p.get_in_range<int>("nodes_v", g.nodes_v, 3, 64);
+  g.origin_mm.x = p.get_in_range<double>("origin_x_mm", g.origin_mm.x, -1000.0, 1000.0);
+  g.origin_mm.y = p.get_in_range<double>("origin_y_mm", g.origin_mm.y, -1000.0, 1000.0);
+  w.table_height_mm = p.get_in_range<double>("table_height_mm", w.table_height_mm, -500.0, 500.0);
+  w.initial_stiffness_nm_per_rad =
+      p.get_in_range<double>("initial_stiffness_nm_per_rad", w.initial_stiffness_nm_per_rad, 0.0, 1000.0);
+  const double zero_hand[robot::kHandJoints] = {};
+  w.initial_arm_rad[0] = read_angles_deg(p, "arm_r_deg", kParkedArmDeg[0]);
+  w.initial_arm_rad[1] = read_angles_deg(p, "arm_l_deg", kParkedArmDeg[1]);
+  w.initial_hand_rad[0] = read_angles_deg(p, "hand_r_deg", zero_hand);
+  w.initial_hand_rad[1] = read_angles_deg(p, "hand_l_deg", zero_hand);
+  // The physics switches (world_params.h), for the failing variants of tests.
+  w.hand_contacts = p.get<bool>("hand_contacts", true);
+  w.finger_friction = p.get<bool>("finger_friction", true);
+  w.table_friction = p.get<bool>("table_friction", true);
+  w.joint_compliance = p.get<bool>("joint_compliance", true);
+
+  c.truth_every_steps = p.get_in_range<int>("truth_every_steps", c.truth_every_steps, 1, 1000);
+  c.truth_stride = p.get_in_range<int>("truth_stride", c.truth_stride, 1, 8);
+  if ((g.nodes_u - 1) % c.truth_stride != 0 || (g.nodes_v - 1) % c.truth_stride != 0) {
+    p.fail("truth_stride", "must divide the grid's intervals (nodes_u - 1 = " + std::to_string(g.nodes_u - 1) +
+                               ", nodes_v - 1 = " + std::to_string(g.nodes_v - 1) + ")");
+  }
+  c.bus_prefix = *drivers::bus_prefix_from_params(p, std::string(drivers::kAutoBusPrefix));
+  c.bitrate = static_cast<std::uint32_t>(p.get_in_range<int>("bitrate", 1'000'000, 10'000, 1'000'000));
+  c.data_bitrate = static_cast<std::uint32_t>(p.get_in_range<int>("data_bitrate", 5'000'000, 10'000, 8'000'000));
+  return c;
+}
+
+}  // namespace crease::world

@@ -1,0 +1,34 @@
+// The sim_world plugin's parameters (README.md lists them): the world's (WorldParams), the
+// robot's parameter file, what the plugin publishes and the simulated robot's buses. Read and
+// checked at configure; every error names the configuration's file, line and key. Non-RT.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/params.h"
+#include "plugins/sim_world/world_params.h"
+
+namespace crease::world {
+
+struct WorldPluginConfig {
+  std::string robot_yaml;  // `robot`: config/robot/crease_robot.yaml, resolved by Params::get_path
+  WorldParams world;
+  // `sheet_truth` every truth_every_steps world steps (a SheetState export costs about one
+  // world step), with every truth_stride-th node of the world's grid in u and v (2: the 29 x 41
+  // world sheet as the tracking model's 15 x 21, which sheet_score compares node by node).
+  int truth_every_steps = 16;
+  int truth_stride = 1;
+  std::string bus_prefix;  // resolved (`auto`: this creased's own, drivers/host/bus_prefix.h)
+  std::uint32_t bitrate = 1'000'000, data_bitrate = 5'000'000;
+};
+
+// Throws crease::ConfigError naming file, line and key.
+[[nodiscard]] WorldPluginConfig read_world_config(const Params& p);
+
+// The parked pose of each arm (deg, drivers/README.md §4 order) when the parameters give none:
+// each palm 300 mm over the table, facing down, beside the sheet (x = +-230, y = -230 mm).
+inline constexpr double kParkedArmDeg[2][7] = {{-42.8, -34.1, 15.3, 123.9, -171.5, 90.8, 30.2},
+                                               {-5.0, -36.7, 13.0, 125.4, 7.7, -89.4, -5.6}};
+
+}  // namespace crease::world
