@@ -1,0 +1,196 @@
+// The world felt through the real drivers (label hil): hand_driver and arm_driver in a 1 kHz
+// control loop, over the mocked CAN FD buses, against the sim_world plugin in a 1 kHz loop of
+// its own half a period behind, whose devices step in lockstep with the world
+// (plugins/sim_world/world_devices.h). The test writes arm_command and hand_command as a
+// controller would. An arm commanded through arm_command moves the world's fingertip; the
+// right index driven down onto the sheet deviates from its target, and hand_state reports the
+// world's joint angles. Failing variant: the world's contacts switched off, no joint deviates.
+// Waits are on conditions (a loaded machine is slow, never wrong); no timing is asserted.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+
+#include "core/plugin_host.h"
+#include "core/port_types/arm.h"
+#include "core/port_types/hand.h"
+#include "core/port_types/world_state.h"
+#include "rt/clock.h"
+#include "scene.h"
+
+using namespace scene;
+
+namespace {
+
+template <class P>
+bool eventually(P pred, int seconds = 20) {
+  for (int i = 0; i < seconds * 1000 && !pred(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return pred();
+}
+
+std::string degrees(const double* q, int n) {
+  std::string s = "[";
+  for (int i = 0; i < n; ++i) s += (i ? ", " : "") + std::to_string(q[i] * 180.0 / std::numbers::pi);
+  return s + "]";
+}
+
+InstanceSpec spec(const std::string& name, const std::string& lib, const std::string& loop, int order,
+                  const std::string& yaml, std::map<std::string, std::string> ports = {}) {
+  InstanceSpec s;
+  s.name = name;
+  s.library = lib;
+  s.loop = loop;
+  s.order = order;
+  s.params = Params(YAML::Load(yaml), "test.yaml", name + ".params");
+  s.ports = std::move(ports);
+  return s;
+}
+
+// The right index's pad over the sheet's centre at height z (mm), palm forward and down by
+// 30 deg, the other fingers bent back (the press scene of sim_world_press_test.cpp).
+struct Poses {
+  ArmIk ik{robot_model(), robot::Side::right};
+  HandQ hand = index_out();
+  ArmQ at(double z, const ArmQ& guess) {
+    return ik.solve("ffpad", {0, 0, z}, palm_forward_down(robot::Side::right, deg(30)), hand, guess);
+  }
+};
+
+struct Robot {
+  Robot(bool contacts, const ArmQ& start, const HandQ& hand) : host({CREASE_PLUGIN_DIR}) {
+    const std::string prefix = "crease-t-wd-" + std::to_string(::getpid()) + (contacts ? "-on" : "-off");
+    host.add_loop({"control", 1000.0, 0, -1});
+    host.add_loop({"world", 1000.0, 0, -1, 500'000});  // half a period behind the drivers
+    host.add_instance(spec("world", "sim_world", "world", 0,
+                           "{robot: " CREASE_SOURCE_DIR "/config/robot/crease_robot.yaml, bus_prefix: " + prefix +
+                               ", randomise: false, initial_stiffness_nm_per_rad: 2, hand_contacts: " +
+                               (contacts ? "true" : "false") + ", arm_r_deg: " + degrees(start.data(), 7) +
+                               ", hand_r_deg: " + degrees(hand.data(), 20) + "}"));
+    // timeout_cycles wide: a late wake-up of a loaded machine must not put a link in its safe state.
+    host.add_instance(spec("hand_r", "hand_driver", "control", 1,
+                           "{bus_prefix: " + prefix + ", bus: hand_r, node: 1, timeout_cycles: 100}",
+                           {{"hand_state", "hand_r.state"}, {"hand_command", "hand_r.command"}}));
+    host.add_instance(spec("arm_r", "arm_driver", "control", 2,
+                           "{bus_prefix: " + prefix + ", bus: arm_r, node: 10, timeout_cycles: 100}",
+                           {{"arm_state", "arm_r.state"}, {"arm_command", "arm_r.command"}}));
+    hand_cmd = host.ports().bind_latest_writer("hand_r.command", port_type_of<HandCommand>(), "test");
+    arm_cmd = host.ports().bind_latest_writer("arm_r.command", port_type_of<ArmCommand>(), "test");
+    host.start();
+  }
+  ~Robot() { host.stop(); }
+  template <class T>
+  T read(const char* port) {
+    T v{};
+    const auto* ch = host.ports().find_latest(port);
+    REQUIRE(ch != nullptr);
+    ch->read(&v, 0);
+    return v;
+  }
+  void command_hand(const HandQ& q, double stiffness) {
+    HandCommand c;
+    for (int j = 0; j < HandCommand::kJoints; ++j) {
+      c.target_rad[j] = static_cast<float>(q[j]);
+      c.stiffness_nm_per_rad[j] = static_cast<float>(stiffness);
+    }
+    c.enable = 1;
+    c.timestamp_ns = rt::now_ns();
+    hand_cmd->write(&c, c.timestamp_ns);
+  }
+  void command_arm(const ArmQ& q) {
+    ArmCommand c;
+    for (int j = 0; j < ArmCommand::kJoints; ++j) c.position_rad[j] = static_cast<float>(q[j]);
+    c.timestamp_ns = rt::now_ns();
+    arm_cmd->write(&c, c.timestamp_ns);
+  }
+  // The arm's drive has reached q (as arm_state reports it) and the world has stepped 300 more
+  // steps (0.3 s of world time) since: the hand has settled.
+  bool reach(const ArmQ& q) {
+    const bool reached = eventually([&] {
+      const ArmState a = read<ArmState>("arm_r.state");
+      double worst = 0;
+      for (int j = 0; j < 7; ++j) worst = std::max(worst, std::fabs(a.position_rad[j] - q[j]));
+      return worst < 1e-4;
+    });
+    const std::uint64_t step = read<WorldState>("world_state").step;
+    return reached && eventually([&] { return read<WorldState>("world_state").step > step + 300; });
+  }
+  PluginHost host;
+  rt::LatestChannel* hand_cmd = nullptr;
+  rt::LatestChannel* arm_cmd = nullptr;
+};
+
+struct Pressed {
+  double lift_dz_mm = 0, lift_dxy_mm = 0;  // the fingertip's motion when the arm lifted it 20 mm
+  double ffj3_dev_rad = 0, wrj1_dev_rad = 0;  // hand_state's angle - the commanded target
+  double worst_vs_world_rad = 0;  // hand_state against world_state's joint angles
+  double force_n = 0, tip_z_mm = 0;
+  DeviceHealth hand_health = DeviceHealth::fault, arm_health = DeviceHealth::fault;
+};
+
+// From the pad 20 mm over the sheet's centre: up to 40 mm (the arm moves the fingertip), then
+// down to 6 mm below the table's top (the index presses onto the sheet on the table).
+Pressed run(bool contacts) {
+  Poses poses;
+  const ArmQ q20 = poses.at(20, arm_guess()), q40 = poses.at(40, q20), qdown = poses.at(-6, q20);
+  Robot robot(contacts, q20, poses.hand);
+  REQUIRE(eventually([&] {
+    return robot.read<ArmState>("arm_r.state").health == DeviceHealth::ok &&
+           robot.read<HandState>("hand_r.state").health == DeviceHealth::ok;
+  }));
+  robot.command_hand(poses.hand, 2.0);
+  robot.command_arm(q20);
+  REQUIRE(eventually([&] { return robot.read<ArmState>("arm_r.state").drive_state == 4; }));  // operation enabled
+  REQUIRE(robot.reach(q20));
+  Pressed out;
+  const WorldState w20 = robot.read<WorldState>("world_state");
+  robot.command_arm(q40);
+  REQUIRE(robot.reach(q40));
+  const WorldState w40 = robot.read<WorldState>("world_state");
+  const WorldFingertip &a = w20.hand[0].tip[0], &b = w40.hand[0].tip[0];
+  out.lift_dz_mm = b.position_mm[2] - a.position_mm[2];
+  out.lift_dxy_mm = std::hypot(b.position_mm[0] - a.position_mm[0], b.position_mm[1] - a.position_mm[1]);
+
+  robot.command_arm(qdown);
+  REQUIRE(robot.reach(qdown));
+  const HandState h = robot.read<HandState>("hand_r.state");
+  const WorldState w = robot.read<WorldState>("world_state");
+  out.ffj3_dev_rad = h.position_rad[FFJ3] - poses.hand[FFJ3];
+  out.wrj1_dev_rad = h.position_rad[WRJ1] - poses.hand[WRJ1];
+  for (int j = 0; j < 20; ++j)
+    out.worst_vs_world_rad = std::max(out.worst_vs_world_rad, double(std::fabs(h.position_rad[j] - w.hand[0].joint_rad[j])));
+  out.force_n = w.hand[0].tip[0].normal_force_n;
+  out.tip_z_mm = w.hand[0].tip[0].position_mm[2];
+  out.hand_health = h.health;
+  out.arm_health = robot.read<ArmState>("arm_r.state").health;
+  MESSAGE(std::string(contacts ? "contacts on" : "contacts off") << ": lift " << out.lift_dz_mm << " mm up, " << out.lift_dxy_mm
+          << " mm aside; pressed: FFJ3 " << out.ffj3_dev_rad << " rad, WRJ1 " << out.wrj1_dev_rad
+          << " rad off target, index force " << out.force_n << " N, pad at z " << out.tip_z_mm
+          << " mm; hand_state vs the world " << out.worst_vs_world_rad << " rad; hand commands sent "
+          << h.commands_sent << ", not acknowledged within 2 cycles " << h.commands_failed);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("hand_driver and arm_driver against the world: the arm moves the fingertip, the pressed index deviates") {
+  const Pressed on = run(true);
+  CHECK(on.lift_dz_mm == doctest::Approx(20.0).epsilon(0.01));
+  CHECK(on.lift_dxy_mm < 0.2);
+  CHECK(on.force_n > 0.1);
+  CHECK(std::fabs(on.ffj3_dev_rad) > 0.005);  // the sheet on the table pushes the index back
+  CHECK(std::fabs(on.wrj1_dev_rad) > 0.005);
+  CHECK(on.tip_z_mm > 0.0);                   // held on the sheet, not driven into the table
+  CHECK(on.worst_vs_world_rad < 1e-3);        // what the driver reads is the world's angle
+  CHECK(on.hand_health != DeviceHealth::fault);
+  CHECK(on.arm_health != DeviceHealth::fault);
+
+  // Failing variant: without the world's contacts the finger meets nothing and keeps its target.
+  const Pressed off = run(false);
+  CHECK(off.lift_dz_mm == doctest::Approx(20.0).epsilon(0.01));
+  CHECK(off.force_n == 0.0);
+  CHECK(std::fabs(off.ffj3_dev_rad) < 1e-4);
+  CHECK(std::fabs(off.wrj1_dev_rad) < 1e-4);
+  CHECK(off.tip_z_mm < -5.0);  // through the sheet and the table top
+}
