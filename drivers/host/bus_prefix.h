@@ -2,7 +2,8 @@
 // `<prefix>-hand_l`, ... (abstract AF_UNIX names, shared by every process of the machine).
 //
 //   bus_prefix: auto        "crease-sim-<pid>": the same in every plugin of one process (the
-//                           sim_devices instance and the drivers of one creased meet), another
+//                           sim_world or sim_devices instance and the drivers of one creased
+//                           meet), another
 //                           in the next creased, so two simulated robots run side by side
 //                           (two daemons in one process would share it: give them fixed ones)
 //   bus_prefix: crease-sim  a fixed name, for separate processes that must meet on the buses

@@ -17,7 +17,9 @@ std::unique_ptr<CanBus> open_bus_from_params(const Params& p) {
       return std::make_unique<MockCanBus>(MockCanBusConfig{bus, host_node, 1'000'000, 5'000'000});
     } catch (const std::exception& e) {
       p.fail("bus", std::string(e.what()) +
-                        (prefix ? " (is a sim_devices instance with the same bus_prefix listed before this one?)" : ""));
+                        (prefix ? " (is a sim_world or sim_devices instance with the same bus_prefix listed before "
+                                  "this one?)"
+                                : ""));
     }
   }
   if (kind == "socketcan") {

@@ -1,4 +1,4 @@
-// Plugin `sheet_truth` (model loop): the simulated world's sheet until the physics twin lands —
+// Plugin `sheet_truth` (model loop): an analytic sheet for the tracking benchmarks and tests —
 // the analytic fold script of plugins/sheet_model (exact geometry, no physics) played from
 // activation. Writes `sheet_truth` (latest, SheetState: positions and normals; no strain).
 // Parameters: fold (half | diagonal | two_folds | unfold), start_s (delay before the fold),

@@ -169,7 +169,7 @@ TEST_CASE("two creased on config/sim.yaml at once: each on its own buses, both 0
 TEST_CASE("the buses are the daemon's own: crease-sim-<pid>-*, a taken name refused naming the key") {
   TempDir tmp;
   Robot a("a", tmp.path);
-  // Take the bus a's sim_devices will create, as a second robot with a shared prefix would.
+  // Take a bus a's world will create, as a second robot with a shared prefix would.
   crease::drivers::MockCanBroker taken({a.prefix + "-arm_r", 0, 0, false});
   a.start();
   CHECK(a.wait_exit() == 2);  // a configuration error: nothing started
