@@ -56,7 +56,7 @@ TactileParams read_tactile(const std::string& file, const MapReader& side) {
   if (kind == "taxel_matrix") {
     const MapReader m(file, node, path,
                       {"kind", "pitch_mm", "rate_hz", "range_kpa", "adc_bits", "noise_kpa",
-                       "threshold_kpa"});
+                       "threshold_kpa", "taxel_area_mm2", "contact_sigma_mm"});
     t.kind = TactileKind::taxel_matrix;
     auto& x = t.taxel;
     x.pitch_mm = number(file, m, "pitch_mm", 0.0, 50.0, true);
@@ -65,6 +65,8 @@ TactileParams read_tactile(const std::string& file, const MapReader& side) {
     x.adc_bits = static_cast<int>(read_int(file, m.require("adc_bits"), m.path_of("adc_bits"), 1, 16));
     x.noise_kpa = number(file, m, "noise_kpa", 0.0, x.range_kpa, false);
     x.threshold_kpa = number(file, m, "threshold_kpa", 0.0, x.range_kpa, false);
+    x.taxel_area_mm2 = number(file, m, "taxel_area_mm2", 0.0, 100.0, true);
+    x.contact_sigma_mm = number(file, m, "contact_sigma_mm", 0.0, 20.0, true);
   } else if (kind == "pst") {
     const MapReader m(file, node, path,
                       {"kind", "rate_hz", "range_kpa", "kpa_per_n", "noise_kpa", "drift_kpa_per_s",

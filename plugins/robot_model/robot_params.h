@@ -31,13 +31,19 @@ struct TaxelMatrixParams {
   int adc_bits = 12;
   double noise_kpa = 1.0;      // standard deviation of the noise floor
   double threshold_kpa = 8.0;  // pressures below read 0
+  // Calibration: the pad area each taxel stands for (mm^2): a fingertip's normal force is the
+  // sum of its taxels' pressures times this (kPa x mm^2 / 1000 = N). The simulated sensor
+  // (plugins/sim_world/tactile_model.h) spreads a contact's force as a Gaussian of standard
+  // deviation contact_sigma_mm over the pad.
+  double taxel_area_mm2 = 9.0;
+  double contact_sigma_mm = 2.0;
 };
 
 // The left hand's PST air-pressure sensors (drivers/README.md §3, pressure frame).
 struct PstParams {
   double rate_hz = 1000.0;
   double range_kpa = 100.0;
-  double kpa_per_n = 10.0;  // cavity pressure per newton of fingertip force
+  double kpa_per_n = 10.0;  // calibration: cavity pressure per newton of fingertip force
   double noise_kpa = 0.01;
   double drift_kpa_per_s = 0.0;
   double highpass_time_constant_s = 30.0;  // drift compensation of the sensor electronics

@@ -58,6 +58,8 @@ TEST_CASE("the shipped parameters: mounting, materials, friction and sensors per
   CHECK(r.tactile.kind == TactileKind::taxel_matrix);
   CHECK(r.tactile.taxel.pitch_mm == 3.0);
   CHECK(r.tactile.taxel.threshold_kpa > r.tactile.taxel.noise_kpa);
+  CHECK(r.tactile.taxel.taxel_area_mm2 == 11.0);
+  CHECK(r.tactile.taxel.contact_sigma_mm == 2.0);
   CHECK(l.tactile.kind == TactileKind::pst);
   CHECK(l.tactile.pst.rate_hz == 1000.0);
   CHECK(l.tactile.pst.noise_kpa < r.tactile.taxel.noise_kpa);  // the PST sensors are the sensitive ones
@@ -85,6 +87,12 @@ TEST_CASE("errors name the file, line, column and key") {
   SUBCASE("a number out of range") {
     CHECK(error_of("r.yaml", "rubber: 1.2", "rubber: -1").find("materials.rubber: must be in [0, 10], got -1") !=
           std::string::npos);
+  }
+  SUBCASE("a taxel calibration out of range") {
+    CHECK(error_of("c.yaml", "taxel_area_mm2: 11.0", "taxel_area_mm2: 0")
+              .find("sides.right.tactile.taxel_area_mm2: must be in (0, 100], got 0") != std::string::npos);
+    CHECK(error_of("c2.yaml", "contact_sigma_mm: 2.0", "contact_sigma_mm: -1")
+              .find("sides.right.tactile.contact_sigma_mm: must be in (0, 20], got -1") != std::string::npos);
   }
   SUBCASE("a missing mounting") {
     CHECK(error_of("mm.yaml", "    mount: {xyz_mm: [-300, -450, 1300], rpy_deg: [180, 0, 0]}\n", "")
