@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
+
 namespace crease::drivers {
 
 std::string auto_bus_prefix() { return "crease-sim-" + std::to_string(::getpid()); }
@@ -34,6 +36,24 @@ std::string prefixed_bus(const std::string& prefix, std::string_view bus) {
   full += '-';
   full += bus;
   return full;
+}
+
+bool valid_link_name(std::string_view name) noexcept {
+  if (name.empty() || name.size() > 32) return false;
+  for (char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                    c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return name != "." && name != "..";
+}
+
+std::string simulated_link_path(const std::string& prefix, std::string_view name) {
+  const char* dir = std::getenv("XDG_RUNTIME_DIR");
+  std::string path = dir != nullptr && dir[0] == '/' ? dir : "/tmp";
+  path += '/';
+  path += prefixed_bus(prefix, name);
+  return path;
 }
 
 }  // namespace crease::drivers

@@ -4,6 +4,11 @@
 
 namespace crease::drivers::sim {
 
+void SimTactile::set_pressures(const float (&kpa)[tactile::kFingertips][tactile::kTaxels]) noexcept {
+  for (int ft = 0; ft < tactile::kFingertips; ++ft)
+    for (int t = 0; t < tactile::kTaxels; ++t) pressure_kpa_[ft][t] = kpa[ft][t];
+}
+
 void SimTactile::step(std::int64_t now_ns) noexcept {
   if (t0_ns_ == 0) t0_ns_ = now_ns;
   SerialFrame f;
@@ -25,7 +30,9 @@ void SimTactile::step(std::int64_t now_ns) noexcept {
   s.device_time_us = static_cast<std::uint32_t>((now_ns - t0_ns_) / 1000);
   s.sample_counter = counter_++;
   s.valid = 0x1F;
-  for (int ft = 0; ft < tactile::kFingertips; ++ft) {
+  for (int ft = 0; ft < tactile::kFingertips && external_; ++ft)
+    for (int t = 0; t < tactile::kTaxels; ++t) s.pressure_kpa[ft][t] = pressure_kpa_[ft][t];
+  for (int ft = 0; ft < tactile::kFingertips && !external_; ++ft) {
     const float force = force_[ft].load(std::memory_order_relaxed);
     for (int t = 0; t < tactile::kTaxels; ++t) {
       const float d = (static_cast<float>(t) - 16.5f) / 8.0f;

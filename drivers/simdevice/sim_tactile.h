@@ -1,7 +1,8 @@
 // SimTactile: the device side of the tactile protocol (drivers/README.md §6) on a byte fd (a
 // pty master). After Start it streams samples at the requested rate; each fingertip's taxels
-// follow the contact force set by the world (a fixed bell-shaped footprint, 10 kPa per N at
-// the centre taxel). step() is non-blocking.
+// follow the contact force set with set_contact_force (a fixed bell-shaped footprint, 10 kPa
+// per N at the centre taxel), or, with external_pressures, the taxel pressures a simulated
+// world computed (set_pressures: plugins/sim_world/tactile_model.h). step() is non-blocking.
 #pragma once
 
 #include <atomic>
@@ -13,9 +14,11 @@ namespace crease::drivers::sim {
 
 class SimTactile {
  public:
-  explicit SimTactile(int fd) noexcept : link_(fd) {}
+  explicit SimTactile(int fd, bool external_pressures = false) noexcept : link_(fd), external_(external_pressures) {}
   void step(std::int64_t now_ns) noexcept;
   void set_contact_force(int fingertip, float force_n) noexcept { force_[fingertip].store(force_n); }
+  // external_pressures: what the next samples carry (kPa), from the thread that calls step().
+  void set_pressures(const float (&kpa)[tactile::kFingertips][tactile::kTaxels]) noexcept;
   void set_silent(bool s) noexcept { silent_.store(s); }
   [[nodiscard]] std::uint64_t samples_sent() const noexcept { return sent_.load(); }
   [[nodiscard]] std::uint16_t rate_hz() const noexcept { return rate_pub_.load(); }
@@ -29,6 +32,8 @@ class SimTactile {
   std::atomic<std::uint16_t> rate_pub_{0};
   std::atomic<float> force_[tactile::kFingertips] = {};
   std::atomic<bool> silent_{false};
+  const bool external_;
+  float pressure_kpa_[tactile::kFingertips][tactile::kTaxels] = {};
 };
 
 }  // namespace crease::drivers::sim

@@ -9,7 +9,9 @@
 //   node            device node id 1..126                                         required
 //   host_node       our node id on a mock bus (default 100)
 //   pressure_sensors true for the left hand's air-pressure sensors (default false)
-//   tactile_device  serial device of the tactile matrix (default: none)
+//   tactile_device  serial device of the tactile matrix (default: none); a bare name (no '/')
+//                   with bus_prefix is the simulated robot's link of that name
+//                   (drivers/host/bus_prefix.h: simulated_link_path, made by sim_world)
 //   tactile_rate_hz 1..1000 (default 250)
 //   timeout_cycles  cycles without a fresh status before fault (default 2)
 //   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
@@ -26,6 +28,7 @@
 #include "core/plugin.h"
 #include "core/port_types/hand.h"
 #include "core/port_types/tactile.h"
+#include "drivers/host/bus_prefix.h"
 #include "drivers/host/device_port_glue.h"
 #include "drivers/host/hand_host.h"
 #include "drivers/host/tactile_host.h"
@@ -42,7 +45,13 @@ class HandDriver final : public Plugin {
     cfg.pressure_sensors = p.get<bool>("pressure_sensors", false);
     host_ = std::make_unique<dr::HandHost>(*bus_, cfg);
     if (p.has("tactile_device")) {
-      const std::string dev = p.get<std::string>("tactile_device");
+      std::string dev = p.get<std::string>("tactile_device");
+      if (dev.find('/') == std::string::npos) {  // a bare name: a simulated robot's link
+        const auto prefix = dr::bus_prefix_from_params(p, std::nullopt);
+        if (!prefix) p.fail("tactile_device", "a bare name is a simulated robot's link and needs bus_prefix; a device is a path");
+        if (!dr::valid_link_name(dev)) p.fail("tactile_device", "a link name is 1..32 of [A-Za-z0-9._-]");
+        dev = dr::simulated_link_path(*prefix, dev);
+      }
       try {
         serial_ = std::make_unique<dr::SerialPort>(dr::SerialConfig{dev, 1'000'000, false});
       } catch (const std::exception& e) {

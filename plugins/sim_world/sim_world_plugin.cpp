@@ -7,6 +7,9 @@
 // the control loop (a step costs about a fifth of a period).
 //   output world_state  (latest WorldState: fingertips, contact forces, joint angles, counters)
 //   output sheet_truth  (latest SheetState: the world's sheet, every truth_every_steps steps)
+// The fingertips' forces reach the drivers as tactile readings (world_tactile.h): the right
+// hand's taxel matrix on a pty link (hand_driver `tactile_device: tactile_r`), the left hand's
+// PST sensors in its pressure frames.
 // The devices answer on `<bus_prefix>-hand_r`, `-hand_l`, `-arm_r`, `-arm_l` as sim_devices'
 // do (this plugin takes its place; the drivers' parameters are the same). Parameters:
 // world_config.h and README.md.
@@ -19,11 +22,13 @@
 #include "core/plugin.h"
 #include "core/port_types/sheet_state.h"
 #include "core/port_types/world_state.h"
+#include "drivers/host/bus_prefix.h"
 #include "plugins/robot_model/robot_model.h"
 #include "plugins/sim_world/randomise.h"
 #include "plugins/sim_world/sim_world.h"
 #include "plugins/sim_world/world_config.h"
 #include "plugins/sim_world/world_devices.h"
+#include "plugins/sim_world/world_tactile.h"
 
 namespace {
 
@@ -54,6 +59,13 @@ class SimWorldPlugin final : public Plugin {
       p.fail("bus_prefix", std::string("cannot create the mocked buses: ") + e.what() +
                                " (is another simulated robot running with this prefix?)");
     }
+    try {
+      const std::string link =
+          cfg_.tactile_link.empty() ? std::string() : drivers::simulated_link_path(cfg_.bus_prefix, cfg_.tactile_link);
+      tactile_ = std::make_unique<wd::WorldTactile>(robot_->params(), cfg_.world.seed, link);
+    } catch (const std::exception& e) {
+      p.fail("tactile_link", e.what());
+    }
     full_ = std::make_unique<SheetState>();
     if (cfg_.truth_stride > 1) truth_ = std::make_unique<SheetState>();
     state_ = std::make_unique<WorldState>();
@@ -67,6 +79,7 @@ class SimWorldPlugin final : public Plugin {
 
   Status update(const Cycle& cycle) override {
     devices_->step_rt();
+    tactile_->step_rt(world_->state(), cfg_.world.dt_s, devices_->robot(), devices_->device_time_ns());
     *state_ = world_->state();
     state_->timestamp_ns = cycle.time_ns;  // the port's stamp: the loop's clock
     world_out_.write(*state_, cycle.time_ns);
@@ -75,6 +88,7 @@ class SimWorldPlugin final : public Plugin {
   }
 
   void cleanup() override {
+    tactile_.reset();
     devices_.reset();  // the devices and their buses first: they reference the world
     world_.reset();
     robot_.reset();
@@ -131,6 +145,7 @@ class SimWorldPlugin final : public Plugin {
   std::unique_ptr<robot::RobotModel> robot_;
   std::unique_ptr<wd::World> world_;
   std::unique_ptr<wd::WorldDevices> devices_;
+  std::unique_ptr<wd::WorldTactile> tactile_;
   std::unique_ptr<SheetState> full_, truth_;
   std::unique_ptr<WorldState> state_;
   LatestOutput<WorldState> world_out_;
