@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <string>
 
 using namespace crease;
@@ -52,4 +53,15 @@ TEST_CASE("a bad prefix is an error with file:line:column and the key") {
   CHECK(error_of([] { (void)dr::bus_prefix_from_params(parse("bus_prefix: [a]"), std::nullopt); })
             .find("plugins[2].params.bus_prefix: expected a string") != std::string::npos);
   CHECK(dr::bus_prefix_problem(std::string(64, 'x')).empty());
+}
+
+TEST_CASE("a simulated robot's serial link: <runtime dir>/<prefix>-<name>, names checked") {
+  const char* xdg = std::getenv("XDG_RUNTIME_DIR");
+  const std::string dir = xdg != nullptr && xdg[0] == '/' ? xdg : "/tmp";
+  CHECK(dr::simulated_link_path("crease-sim-42", "tactile_r") == dir + "/crease-sim-42-tactile_r");
+  CHECK(dr::valid_link_name("tactile_r"));
+  CHECK_FALSE(dr::valid_link_name(""));
+  CHECK_FALSE(dr::valid_link_name(".."));
+  CHECK_FALSE(dr::valid_link_name("a/b"));
+  CHECK_FALSE(dr::valid_link_name(std::string(33, 'a')));
 }

@@ -10,6 +10,7 @@
 #include "core/port_types/hand.h"
 #include "drivers/can/mock_can_broker.h"
 #include "drivers/can/mock_can_bus.h"
+#include "drivers/host/bus_prefix.h"
 #include "drivers/simdevice/device_thread.h"
 #include "drivers/simdevice/sense_to_command_tap.h"
 #include "drivers/simdevice/sim_hand.h"
@@ -58,6 +59,27 @@ TEST_CASE("hand_driver: fresh state, no allocation, safe within 3 cycles of sile
 
 TEST_CASE("hand_driver: a bus nobody serves is a configuration error naming the key") {
   Rig("hand_r", "hand_driver", "hand_state").check_unserved_bus_is_config_error();
+}
+
+TEST_CASE("hand_driver: a bare tactile_device name is a simulated robot's link and needs bus_prefix") {
+  Rig rig("hand_r", "hand_driver", "hand_state");
+  const std::string prefix = "crease-t-hdtl-" + std::to_string(::getpid());
+  dr::MockCanBroker broker({prefix + "-hand_r", 1'000'000, 5'000'000, false});
+  const auto error_of = [&](const std::string& yaml) -> std::string {
+    try {
+      rig.add(yaml);
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const std::string bare = error_of("{bus: " + prefix + "-hand_r, node: 1, tactile_device: tactile_r}");
+  CHECK(bare.find("test.yaml") != std::string::npos);
+  CHECK(bare.find("tactile_device: a bare name is a simulated robot's link and needs bus_prefix") != std::string::npos);
+  // With the prefix: the link <runtime dir>/<prefix>-tactile_r, which no world has made here.
+  const std::string missing = error_of("{bus_prefix: " + prefix + ", bus: hand_r, node: 1, tactile_device: tactile_r}");
+  CHECK(missing.find("tactile_device") != std::string::npos);
+  CHECK(missing.find(dr::simulated_link_path(prefix, "tactile_r")) != std::string::npos);
 }
 
 namespace {
