@@ -29,6 +29,33 @@ inline constexpr std::array<std::string_view, kHandJoints> kHandJointNames = {
     "LFJ5", "LFJ4", "LFJ3", "LFJ2",  // little finger: metacarpal, then as the others
     "THJ5", "THJ4", "THJ3", "THJ2", "THJ1"};  // thumb: base rotation ... distal flexion
 
+// The index of a hand joint by its name without prefix ("FFJ3" -> 3), or -1.
+[[nodiscard]] constexpr int hand_joint_index(std::string_view name) noexcept {
+  for (int j = 0; j < kHandJoints; ++j)
+    if (kHandJointNames[static_cast<std::size_t>(j)] == name) return j;
+  return -1;
+}
+
+// The finger a hand joint moves (0 ff, 1 mf, 2 rf, 3 lf, 4 th; kFingertipNames' order), or -1
+// for the wrist.
+[[nodiscard]] constexpr int finger_of_hand_joint(int j) noexcept {
+  if (j < 2) return -1;
+  if (j < 5) return 0;
+  if (j < 8) return 1;
+  if (j < 11) return 2;
+  if (j < 15) return 3;
+  return 4;
+}
+
+// Flexion joints of the four fingers: J3 (MCP) and J2 (PIP, with the coupled DIP). The thumb's
+// and the abduction joints are not.
+[[nodiscard]] constexpr bool is_finger_flexion_joint(int j) noexcept {
+  const int f = finger_of_hand_joint(j);
+  if (f < 0 || f > 3) return false;
+  const std::string_view n = kHandJointNames[static_cast<std::size_t>(j)];
+  return n.ends_with("J3") || n.ends_with("J2");
+}
+
 // Fingertips in the order of the tactile and pressure frames (§3, §6).
 inline constexpr int kFingertips = 5;
 inline constexpr std::array<std::string_view, kFingertips> kFingertipNames = {"ff", "mf", "rf", "lf",

@@ -1,0 +1,47 @@
+// The force controller's configuration: its parameters (README.md) and, from the robot's
+// files (config/robot/), the hand's joint limits and its tactile calibration. Units: rad, s, N,
+// N m/rad, kPa.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "core/port_types/hand.h"
+#include "plugins/robot_model/robot_layout.h"
+#include "plugins/robot_model/robot_params.h"
+
+namespace crease::force {
+
+inline constexpr int kJoints = HandCommand::kJoints;
+inline constexpr int kFingers = 5;       // ff mf rf lf th
+inline constexpr int kForceFingers = 4;  // the thumb is never force controlled (seed 000 Eq. 6)
+
+enum class OnBadInput : std::uint8_t { hold, retreat };
+
+struct ForceConfig {
+  robot::TactileKind sensor = robot::TactileKind::pst;  // pst: hand_state pressures; taxel_matrix: `tactile`
+  double kpa_per_n = 10.0;       // PST calibration (robot YAML)
+  double taxel_area_mm2 = 11.0;  // taxel calibration (robot YAML)
+  // Eq. 6: the per-joint gain modulation alpha_i (only the four fingers' J3 and J2), and k_P
+  // (rad of target per N of error per s; per cycle: k_p x dt).
+  std::array<double, kJoints> alpha{};
+  double k_p = 0.6;
+  std::array<double, kJoints> lower{}, upper{};  // the URDF's joint limits
+  double max_flex_rad = 0.6;      // saturation: flexion beyond the force mode's starting pose
+  double max_rate_rad_s = 1.0;    // every commanded joint, every mode
+  double retreat_rad = 0.15;      // a retreat extends every finger's flexion joints by this
+  double default_stiffness = 2.0; // N m/rad, until a posture goal sets others
+  double force_limit_n = 5.0;     // hard limit per fingertip: exceeded -> retreat, fault event
+  double max_goal_force_n = 4.0;  // goals above are refused (< force_limit_n)
+  double settle_band = 0.05;      // |error| <= band x goal (and >= settle_band_n) ...
+  double settle_band_n = 0.02;
+  double settle_hold_s = 0.05;    // ... for this long: settled
+  OnBadInput on_bad_input = OnBadInput::hold;
+  int stale_cycles = 3;           // hand_state: cycles without a fresh ok status tolerated
+  std::int64_t max_tactile_age_ns = 20'000'000;
+  std::int64_t max_contact_age_ns = 5'000'000;
+  double baseline_time_constant_s = 0.5;  // PST tare while a finger is out of contact
+  bool anti_windup = true;        // false only to show what it prevents (tests)
+};
+
+}  // namespace crease::force
