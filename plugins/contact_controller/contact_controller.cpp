@@ -23,7 +23,7 @@ class ContactController final : public Plugin {
     if (read_command_) command_ = ports.latest_input<HandCommand>("hand_command");
     if (detector_.config().tactile == TactileSource::taxels) tactile_ = ports.latest_input<Tactile>("tactile");
     state_ = ports.latest_output<ContactState>("contact_state", ContactState{});
-    events_ = ports.queue_output<ContactEvent>("contact_event");
+    events_ = ports.queue_output<ContactEvent>("contact_event", 64);  // onsets and releases: a few per second
   }
 
   Status update(const Cycle& c) override {

@@ -90,7 +90,8 @@ bool ContactDetector::step_rt(const ContactInputs& in, ContactState& out, Contac
       s_.armed = 0;
       s_.window_cycles = 0;
     }
-    s_.debounce = 0;
+    s_.debounce = s_.joint_run = 0;
+    s_.tactile_run.fill(0);
     publish();
     return false;
   }
@@ -111,6 +112,8 @@ bool ContactDetector::step_rt(const ContactInputs& in, ContactState& out, Contac
     }
   }
   if (s_.armed == 0) {
+    s_.joint_run = 0;
+    s_.tactile_run.fill(0);
     settle_rt(in, kpa);
     out.deviation_rad = 0;
     for (float& d : out.finger_deviation_rad) d = 0;
@@ -150,26 +153,39 @@ bool ContactDetector::step_rt(const ContactInputs& in, ContactState& out, Contac
     if (fingers == 0 && most >= 0) fingers = static_cast<std::uint8_t>(1u << most);
   }
   const double tac_threshold = in_contact ? c_.tactile_exit_kpa : c_.tactile_enter_kpa;
+  std::uint8_t tac_fingers = 0;
   for (int f = 0; f < kFingers && c_.tactile != TactileSource::none; ++f) {
     const auto fs = static_cast<std::size_t>(f);
-    if ((kpa_valid & (1u << f)) == 0) continue;
-    if (kpa[fs] - s_.baseline_kpa[fs] > tac_threshold) {
-      fingers |= static_cast<std::uint8_t>(1u << f);
-      source |= contact_tactile;
-    }
+    const bool over = (kpa_valid & (1u << f)) != 0 && kpa[fs] - s_.baseline_kpa[fs] > tac_threshold;
+    s_.tactile_run[fs] = over ? s_.tactile_run[fs] + 1 : 0;
+    if (over) tac_fingers |= static_cast<std::uint8_t>(1u << f);
+  }
+  s_.joint_run = joint_raw ? s_.joint_run + 1 : 0;
+  if (tac_fingers != 0) {
+    fingers |= tac_fingers;
+    source |= contact_tactile;
   }
   const bool raw = source != contact_none;
 
+  // Debounce, per source and per fingertip (so that noise on two sensors in turn does not add
+  // up): an onset needs one test to hold for debounce_cycles in a row, a release every test to
+  // stay quiet that long.
   bool changed = false;
-  if (raw != in_contact) {
-    if (++s_.debounce >= c_.debounce_cycles) {
-      s_.debounce = 0;
-      s_.in_contact = raw ? 1 : 0;
+  if (!in_contact) {
+    bool onset = s_.joint_run >= c_.debounce_cycles;
+    for (int f = 0; f < kFingers; ++f) onset = onset || s_.tactile_run[static_cast<std::size_t>(f)] >= c_.debounce_cycles;
+    if (onset) {
+      s_.in_contact = 1;
+      s_.since_ns = in.time_ns;
+      ++s_.onsets;
       changed = true;
-      if (raw) {
-        s_.since_ns = in.time_ns;
-        ++s_.onsets;
-      }
+    }
+    s_.debounce = 0;
+  } else if (!raw) {
+    if (++s_.debounce >= c_.debounce_cycles) {
+      s_.in_contact = 0;
+      s_.debounce = 0;
+      changed = true;
     }
   } else {
     s_.debounce = 0;

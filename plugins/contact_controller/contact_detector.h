@@ -13,8 +13,9 @@
 //    controller flexing the fingers in contact is not read as more contact), P-weighted:
 //    sqrt(sum_j w_j d_j^2), over the hand and per finger.
 //  - Hysteresis: the enter thresholds while out of contact, the lower exit ones while in.
-//    Debounce: the raw decision must hold for debounce_cycles consecutive cycles to change the
-//    state (1: no debounce). Fingers: those whose tactile test fired, and those whose own
+//    Debounce: an onset needs one test (the joints', or one fingertip's tactile test) to fire
+//    debounce_cycles cycles in a row; a release needs every test quiet that long (1: no
+//    debounce). Per test, so that noise on two fingertips in turn does not add up. Fingers: those whose tactile test fired, and those whose own
 //    deviation exceeds half the enter threshold (else the most deviated) when the joints fired.
 //  - Bad input: hand_state health fault, or no fresh healthy status for more than stale_cycles
 //    (degraded counts as not fresh), or taxels older than max_tactile_age_ns: healthy = 0, the
@@ -39,15 +40,15 @@ enum class TactileSource : std::uint8_t { none, pst, taxels };
 
 struct ContactConfig {
   std::array<double, kJoints> weight{};  // P's diagonal; 0: not selected
-  double enter_rad = 0.004;              // Delta theta_max
-  double exit_rad = 0.002;
+  double enter_rad = 0.002;              // Delta theta_max
+  double exit_rad = 0.001;
   int debounce_cycles = 2;
   int settle_cycles = 50;
   double settle_band_rad = 0.001;
   double rearm_rad = 0.01;
   TactileSource tactile = TactileSource::none;
-  double tactile_enter_kpa = 0.05;
-  double tactile_exit_kpa = 0.025;
+  double tactile_enter_kpa = 0.03;
+  double tactile_exit_kpa = 0.015;
   double baseline_time_constant_s = 1.0;
   int stale_cycles = 3;
   std::int64_t max_tactile_age_ns = 20'000'000;
@@ -71,7 +72,9 @@ class ContactDetector {
     std::int64_t since_ns = 0;
     std::uint64_t onsets = 0;
     std::int32_t window_cycles = 0;
-    std::int32_t debounce = 0;
+    std::int32_t debounce = 0;     // quiet cycles in a row while in contact
+    std::int32_t joint_run = 0;    // cycles in a row the joints' test fired
+    std::array<std::int32_t, kFingers> tactile_run{};  // per fingertip, its tactile test
     std::int32_t stale = 0;
     std::uint8_t armed = 0, in_contact = 0, fingers = 0, source = contact_none;
   };

@@ -21,11 +21,12 @@ enum class OnBadInput : std::uint8_t { hold, retreat };
 struct ForceConfig {
   robot::TactileKind sensor = robot::TactileKind::pst;  // pst: hand_state pressures; taxel_matrix: `tactile`
   double kpa_per_n = 10.0;       // PST calibration (robot YAML)
+  double pst_highpass_s = 30.0;  // the PST electronics' high-pass (robot YAML); 0: not undone
   double taxel_area_mm2 = 11.0;  // taxel calibration (robot YAML)
   // Eq. 6: the per-joint gain modulation alpha_i (only the four fingers' J3 and J2), and k_P
   // (rad of target per N of error per s; per cycle: k_p x dt).
   std::array<double, kJoints> alpha{};
-  double k_p = 0.6;
+  double k_p = 2.0;
   std::array<double, kJoints> lower{}, upper{};  // the URDF's joint limits
   double max_flex_rad = 0.6;      // saturation: flexion beyond the force mode's starting pose
   double max_rate_rad_s = 1.0;    // every commanded joint, every mode

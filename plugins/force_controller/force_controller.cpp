@@ -26,6 +26,9 @@ struct Saved {
 
 class ForceController final : public Plugin {
  public:
+  static constexpr std::size_t kGoalQueue = 16;   // goals: a few per motion
+  static constexpr std::size_t kEventQueue = 64;
+
   void configure(const Params& p, PortBinder& ports) override {
     controller_ = HandController(read_force_config(p));
     ports.tunable("k_p", &k_p_, 0.0, 100.0);
@@ -33,11 +36,11 @@ class ForceController final : public Plugin {
     hand_ = ports.latest_input<HandState>("hand_state");
     if (controller_.config().sensor == robot::TactileKind::taxel_matrix) tactile_ = ports.latest_input<Tactile>("tactile");
     contact_ = ports.latest_input<ContactState>("contact_state");
-    goals_ = ports.queue_input<HandGoal>("hand_goal");
+    goals_ = ports.queue_input<HandGoal>("hand_goal", kGoalQueue);
     // The safe value: enable 0, the hand holds its position with zero force (drivers/README.md §3).
     command_ = ports.latest_output<HandCommand>("hand_command", HandCommand{});
     status_ = ports.latest_output<HandControlStatus>("hand_control_status", HandControlStatus{});
-    events_ = ports.queue_output<HandControlEvent>("hand_control_event");
+    events_ = ports.queue_output<HandControlEvent>("hand_control_event", kEventQueue);
   }
 
   Status update(const Cycle& c) override {

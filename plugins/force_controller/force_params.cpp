@@ -60,6 +60,7 @@ ForceConfig read_force_config(const Params& p) {
   const robot::TactileParams& t = model.params().side(s).tactile;
   c.sensor = t.kind;
   c.kpa_per_n = t.pst.kpa_per_n;
+  c.pst_highpass_s = p.get<bool>("undo_highpass", true) ? t.pst.highpass_time_constant_s : 0.0;
   c.taxel_area_mm2 = t.taxel.taxel_area_mm2;
   const auto& joints = model.hand_joints(s);
   for (int j = 0; j < kJoints; ++j) {

@@ -71,6 +71,8 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
     return;
   }
   // PST: pressure above the tare, which follows the sensor while the finger touches nothing.
+  // While pressed, the electronics' high-pass (time constant pst_highpass_s) bleeds a held
+  // pressure away: x = y + (1/tau) integral y dt undoes it.
   const bool contact = contact_fresh(in, c_.max_contact_age_ns);
   const double a = std::min(1.0, in.dt_s / c_.baseline_time_constant_s);
   for (int f = 0; f < kFingers; ++f) {
@@ -81,8 +83,14 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
     const double p = in.hand->pressure_kpa[f];
     const bool pressed = (s_.mode == HandMode::force && (s_.fingers & (1u << f)) != 0) ||
                          (contact && (in.contact->fingers & (1u << f)) != 0);
-    if (contact && !pressed) s_.baseline_kpa[sz(f)] += a * (p - s_.baseline_kpa[sz(f)]);
-    f_[sz(f)] = std::max(0.0, (p - s_.baseline_kpa[sz(f)]) / c_.kpa_per_n);
+    const double above = p - s_.baseline_kpa[sz(f)];
+    if (contact && !pressed) {
+      s_.baseline_kpa[sz(f)] += a * (p - s_.baseline_kpa[sz(f)]);
+      s_.highpass_kpa[sz(f)] = 0;
+    } else if (c_.pst_highpass_s > 0) {
+      s_.highpass_kpa[sz(f)] += above * in.dt_s / c_.pst_highpass_s;
+    }
+    f_[sz(f)] = std::max(0.0, (above + s_.highpass_kpa[sz(f)]) / c_.kpa_per_n);
   }
 }
 
