@@ -47,8 +47,8 @@ struct ContactConfig {
   double settle_band_rad = 0.001;
   double rearm_rad = 0.01;
   TactileSource tactile = TactileSource::none;
-  double tactile_enter_kpa = 0.03;
-  double tactile_exit_kpa = 0.015;
+  double tactile_enter_kpa = 0.045;  // 4.5 x the PST noise (0.01 kPa): 4.5 mN
+  double tactile_exit_kpa = 0.02;
   double baseline_time_constant_s = 1.0;
   int stale_cycles = 3;
   std::int64_t max_tactile_age_ns = 20'000'000;

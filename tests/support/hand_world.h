@@ -114,9 +114,10 @@ class HandWorld {
   static robot::Side other(robot::Side s) { return s == robot::Side::right ? robot::Side::left : robot::Side::right; }
 
   void add_contact() {
-    std::string params = right() ? "{tactile: taxels" : "{tactile: pst";
-    if (!o_.contact_params.empty()) params += ", " + o_.contact_params;
-    params += "}";
+    // The side's tactile sensor unless the test names one.
+    std::string params = "{";
+    if (o_.contact_params.find("tactile: ") == std::string::npos) params += right() ? "tactile: taxels, " : "tactile: pst, ";
+    params += o_.contact_params + "}";
     crease::InstanceSpec s;
     s.name = "contact";
     s.library = "contact_controller";
@@ -210,7 +211,10 @@ class HandWorld {
     world_->step_rt();
     ++k_;
     if (o_.with_contact && first_contact_cycle_ < 0 && contact_r_.value().in_contact != 0) first_contact_cycle_ = k_ - 1;
-    if (first_world_contact_step_ < 0 && tip().contact != 0) first_world_contact_step_ = static_cast<long>(k_ - 1);
+    if (first_world_contact_step_ < 0 && tip().contact != 0) {
+      first_world_contact_step_ = static_cast<long>(k_ - 1);
+      s_at_world_contact_mm_ = s_mm_;
+    }
     if (observer_) observer_();
   }
   void run(double seconds) {
@@ -263,6 +267,8 @@ class HandWorld {
   [[nodiscard]] long first_world_contact_step() const { return first_world_contact_step_; }
   [[nodiscard]] long stopped_cycle() const { return stopped_cycle_; }
   [[nodiscard]] double arm_s_mm() const { return s_mm_; }
+  // How far the arm moved along its path since the world's first contact (mm).
+  [[nodiscard]] double travel_since_contact_mm() const { return s_mm_ - s_at_world_contact_mm_; }
   [[nodiscard]] const ArmPath& path() const { return path_; }
   [[nodiscard]] const HandQ& commanded_targets() const { return target_; }
   // The largest change of a commanded joint target between two cycles since the last reset.
@@ -345,7 +351,7 @@ class HandWorld {
   crease::Tactile tactile_{};
   std::vector<crease::ContactEvent> events_;
   ArmPath path_;
-  double s_mm_ = 0, v_ = 0, v_cmd_ = 0;
+  double s_mm_ = 0, v_ = 0, v_cmd_ = 0, s_at_world_contact_mm_ = 0;
   bool stop_on_contact_ = false;
   long stopped_cycle_ = -1;
   std::uint64_t k_ = 0;
