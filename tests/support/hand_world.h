@@ -96,7 +96,7 @@ class HandWorld {
     stiffness_.fill(o_.stiffness);
     target_ = hand_q_;
 
-    host_.add_loop({"control", 1000.0, 0, -1});
+    loop_ = &host_.add_loop({"control", 1000.0, 0, -1});
     auto& ports = host_.ports();
     hand_w_ = ports.bind_latest_writer("hand_state", crease::port_type_of<crease::HandState>(), "test");
     if (right()) tactile_w_ = ports.bind_latest_writer("tactile", crease::port_type_of<crease::Tactile>(), "test");
@@ -143,6 +143,18 @@ class HandWorld {
     auto& ports = host_.ports();
     command_r_ = crease::rt::LatestReader<crease::HandCommand>(ports.find_latest("hand_command"));
     status_r_ = crease::rt::LatestReader<crease::HandControlStatus>(ports.find_latest("hand_control_status"));
+    if (force_events_r_ == nullptr)  // force_controller writes 64
+      force_events_r_ = ports.bind_queue_reader("hand_control_event", crease::port_type_of<crease::HandControlEvent>(), "test", 64);
+  }
+
+  // A hot-swap of the force controller for a new instance of the same library, at a cycle
+  // boundary, its state carried (save_state / load_state).
+  void swap_force() { host_.swap("force", "force_controller"); }
+  // The failing variant: the force controller unloaded and loaded anew, nothing carried.
+  void reload_force() {
+    host_.unload("force");
+    add_force();
+    rebind_force_readers();
   }
 
   // The arm follows PATH from its start at SPEED (mm/s); STOP_ON_CONTACT: it decelerates at
@@ -156,6 +168,8 @@ class HandWorld {
     stopped_cycle_ = -1;
   }
   // A straight path of the index pad from FROM to TO, IK every step_mm from the current arm.
+  // The tool's point where the arm is on its path now (its commanded pad point).
+  [[nodiscard]] Vec3 here() const { return path_.q.empty() ? o_.start : path_.point(s_mm_); }
   ArmPath line(Vec3 from, Vec3 to, double step_mm = 0.25) {
     ArmPath path;
     path.step_mm = step_mm;
@@ -179,7 +193,7 @@ class HandWorld {
     {
       crease::rt::ScopedRtMark rt;  // only the loop's cycle counts
       const crease::rt::CycleClock clock{k_, t, t, 1'000'000};
-      const_cast<crease::Loop*>(host_.loops().front())->run_cycle_rt(clock);
+      loop_->run_cycle_rt(clock);
     }
     if (o_.with_contact) {
       contact_r_.poll();
@@ -189,6 +203,8 @@ class HandWorld {
     if (o_.with_force) {
       const auto info = command_r_.poll();
       status_r_.poll();
+      crease::HandControlEvent fe;
+      while (force_events_r_->try_pop(&fe)) force_events_.push_back(fe);
       if (info.has_data()) {
         const crease::HandCommand& c = command_r_.value();
         if (c.enable != 0) {
@@ -261,6 +277,7 @@ class HandWorld {
   [[nodiscard]] const crease::HandControlStatus& status() const { return status_r_.value(); }
   [[nodiscard]] const crease::HandCommand& command() const { return command_r_.value(); }
   [[nodiscard]] const std::vector<crease::ContactEvent>& contact_events() const { return events_; }
+  [[nodiscard]] const std::vector<crease::HandControlEvent>& force_events() const { return force_events_; }
   [[nodiscard]] crease::PluginHost& host() { return host_; }
   [[nodiscard]] long cycles() const { return static_cast<long>(k_); }
   [[nodiscard]] long first_contact_cycle() const { return first_contact_cycle_; }
@@ -337,6 +354,7 @@ class HandWorld {
   ArmIk ik_, ik_other_;
   crease::world::TactileModel pst_, taxels_, noise_;
   crease::PluginHost host_;
+  crease::Loop* loop_ = nullptr;
   std::unique_ptr<World> world_;
   KDL::Rotation palm_;
   HandQ hand_q_{}, target_{}, stiffness_{};
@@ -345,11 +363,13 @@ class HandWorld {
   crease::rt::LatestChannel* tactile_w_ = nullptr;
   crease::rt::QueueChannel* goal_w_ = nullptr;
   crease::rt::QueueChannel* events_r_ = nullptr;
+  crease::rt::QueueChannel* force_events_r_ = nullptr;
   crease::rt::LatestReader<crease::ContactState> contact_r_;
   crease::rt::LatestReader<crease::HandCommand> command_r_;
   crease::rt::LatestReader<crease::HandControlStatus> status_r_;
   crease::Tactile tactile_{};
   std::vector<crease::ContactEvent> events_;
+  std::vector<crease::HandControlEvent> force_events_;
   ArmPath path_;
   double s_mm_ = 0, v_ = 0, v_cmd_ = 0, s_at_world_contact_mm_ = 0;
   bool stop_on_contact_ = false;
