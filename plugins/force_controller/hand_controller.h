@@ -1,6 +1,9 @@
 // One hand's command stage (plugins/force_controller): the modes posture, hold and force
 // (C_force, seed 000 Eq. 6) and the safe action retreat, turned into one HandCommand a cycle.
 //
+// Forces (N): the left hand's PST pressure above its tare (which follows the sensor while the
+// finger touches nothing) / kpa_per_n, the sensor's high-pass undone while pressing
+// (x = y + integral y dt / tau); the right hand's taxel sum x taxel_area_mm2 / 1000.
 // Force mode, per finger f in force control (never the thumb):
 //   u_f += k_P (f_target - f_f) dt,   target_i = base_i + alpha_i u_f  (i: f's flexion joints)
 // i.e. Eq. 6's delta theta_i = alpha_i k_P (f_target - f_current) per cycle, with base the
