@@ -150,6 +150,12 @@ class HandWorld {
   // A hot-swap of the force controller for a new instance of the same library, at a cycle
   // boundary, its state carried (save_state / load_state).
   void swap_force() { host_.swap("force", "force_controller"); }
+  void swap_contact() { host_.swap("contact", "contact_controller"); }
+  void reload_contact() {
+    host_.unload("contact");
+    add_contact();
+    contact_r_ = crease::rt::LatestReader<crease::ContactState>(host_.ports().find_latest("contact_state"));
+  }
   // The failing variant: the force controller unloaded and loaded anew, nothing carried.
   void reload_force() {
     host_.unload("force");

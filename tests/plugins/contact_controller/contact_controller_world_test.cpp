@@ -124,3 +124,25 @@ TEST_CASE("free motion: no false contact in 60 s; with the debounce off, sensor 
   CHECK(debounced == 0);
   CHECK(raw > 0);
 }
+
+TEST_CASE("a hot-swap of the contact controller in contact keeps the contact (failing variant: reloaded, it must settle anew)") {
+  for (const bool carried : {true, false}) {
+    CAPTURE(carried);
+    HandWorld w(approach_options(robot::Side::left));
+    REQUIRE(w.approach(20.0));
+    w.run(0.2);
+    REQUIRE(w.contact().onsets == 1);
+    if (carried) w.swap_contact();
+    else w.reload_contact();
+    w.run(0.2);
+    if (carried) {
+      CHECK(w.contact().in_contact == 1);
+      CHECK(w.contact().armed == 1);
+      CHECK(w.contact().onsets == 1);  // no second onset: the same contact
+    } else {
+      CHECK(w.contact().onsets == 0);     // a new count
+      CHECK(w.contact().in_contact == 0);  // and the touching hand, re-armed, taken as relaxed
+      CHECK(w.tip().contact == 1);
+    }
+  }
+}

@@ -243,6 +243,17 @@ TEST_CASE("the commanded targets: flexing in contact is not more contact; a new 
   CHECK(r.out.in_contact == 1);
   CHECK(r.out.deviation_rad == doctest::Approx(0.003).epsilon(0.05));
   CHECK(r.out.armed == 1);
+
+  SUBCASE("failing variant: without the commanded targets, the flexing reads as a deviation over ten times larger") {
+    Rig b(config("{enter_rad: 0.002, exit_rad: 0.001}"));
+    b.arm();
+    b.command.target_rad[FFJ3] = 0.003f;
+    for (int i = 0; i < 50; ++i) {
+      b.hand.position_rad[FFJ3] += 0.001f;  // the finger flexes on with its target, 3 mrad short
+      b.step();
+    }
+    CHECK(b.out.deviation_rad > 0.04f);
+  }
 }
 
 TEST_CASE("stale or faulty hand_state: healthy 0, no onset, no release on stale data") {
