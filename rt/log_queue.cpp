@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "rt/thread_placement.h"
+
 namespace crease::rt {
 
 bool RtLogQueue::try_log(LogLevel level, const char* source, const char* text, std::int64_t time_ns) noexcept {
@@ -36,7 +38,10 @@ std::string format_log_record(const LogRecord& r) {
 }
 
 LogDrain::LogDrain(Sink sink, int poll_ms) : sink_(std::move(sink)), poll_ms_(poll_ms) {
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    place_this_thread_non_rt("crease-log");
+    run();
+  });
 }
 
 LogDrain::~LogDrain() {

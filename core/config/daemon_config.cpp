@@ -97,7 +97,7 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
   if (!root.has("daemon")) return;
   const MapReader m(root.file(), root.get("daemon"), "daemon",
                     {"socket", "socket_group", "report_dir", "duration_s", "lock_memory",
-                     "prefault_heap_mb", "cpu_dma_latency_us"});
+                     "prefault_heap_mb", "cpu_dma_latency_us", "non_rt_cpus"});
   const std::string& f = m.file();
   DaemonSettings& d = cfg.daemon;
   d.loc = m.loc();
@@ -123,6 +123,32 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
   if (m.has("cpu_dma_latency_us")) {
     d.cpu_dma_latency_us = static_cast<int>(read_int(
         f, m.get("cpu_dma_latency_us"), m.path_of("cpu_dma_latency_us"), 0, 100000000));
+  }
+  if (m.has("non_rt_cpus")) {
+    const YAML::Node list = m.get("non_rt_cpus");
+    const std::string path = m.path_of("non_rt_cpus");
+    d.non_rt_cpus_loc = loc_of(f, list);
+    if (!list.IsSequence() || list.size() == 0) {
+      throw ConfigError(loc_of(f, list), path, "expected a non-empty list of CPU indices, e.g. [0]");
+    }
+    std::vector<int> cpus;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      cpus.push_back(static_cast<int>(read_int(f, list[i], path + "[" + std::to_string(i) + "]", 0, 1023)));
+    }
+    d.non_rt_cpus = cpus;
+  }
+}
+
+// A pinned loop's CPU is the loop's alone: non_rt_cpus may not list it.
+void check_non_rt_cpus(const DaemonConfig& cfg) {
+  if (!cfg.daemon.non_rt_cpus) return;
+  for (int c : *cfg.daemon.non_rt_cpus) {
+    for (const LoopConfig& l : cfg.loops) {
+      if (l.cpu == c) {
+        throw ConfigError(cfg.daemon.non_rt_cpus_loc, "daemon.non_rt_cpus",
+                          "CPU " + std::to_string(c) + " is loop '" + l.name + "''s own (its cpu); list the others");
+      }
+    }
   }
 }
 
@@ -335,6 +361,7 @@ DaemonConfig load_daemon_config_from_string(const std::string& text,
   read_plugin_dirs(root, options, cfg);
   read_daemon(root, cfg);
   read_loops(root, cfg);
+  check_non_rt_cpus(cfg);
   read_plugins(root, cfg);
   read_safety(root, cfg);
   return cfg;

@@ -13,6 +13,7 @@
 
 #include "core/control/protocol.h"
 #include "core/control/socket_file.h"
+#include "rt/thread_placement.h"
 
 namespace crease::control {
 
@@ -342,8 +343,14 @@ void ControlServer::start() {
   if (m.started) return;
   m.started = true;
   m.do_accept();
-  m.work_thread = std::thread([&m] { m.work.run(); });
-  m.io_thread = std::thread([&m] { m.io.run(); });
+  m.work_thread = std::thread([&m] {
+    rt::place_this_thread_non_rt("crease-ctl-work");
+    m.work.run();
+  });
+  m.io_thread = std::thread([&m] {
+    rt::place_this_thread_non_rt("crease-ctl-io");
+    m.io.run();
+  });
 }
 
 void ControlServer::stop() {

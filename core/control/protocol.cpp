@@ -7,7 +7,7 @@ namespace crease::control {
 const std::vector<std::string>& known_commands() {
   static const std::vector<std::string> commands = {
       "status", "loops",      "plugins", "ports", "load",   "unload", "swap",
-      "activate", "deactivate", "param", "stats", "report", "stop"};
+      "activate", "deactivate", "param", "stats", "report", "stop", "threads"};
   return commands;
 }
 

@@ -16,6 +16,7 @@
 #include "core/errors.h"
 #include "rt/clock.h"
 #include "rt/rt_setup.h"
+#include "rt/thread_placement.h"
 
 namespace fs = std::filesystem;
 
@@ -42,9 +43,26 @@ InstanceSpec to_spec(const config::PluginConfig& p, const std::string& file, std
   return s;
 }
 
+// daemon.non_rt_cpus, or every CPU of the process that no loop is pinned to.
+std::vector<int> non_rt_cpus_of(const config::DaemonConfig& c) {
+  if (c.daemon.non_rt_cpus) return *c.daemon.non_rt_cpus;
+  std::vector<int> out;
+  for (int cpu : rt::process_cpus()) {
+    bool pinned = false;
+    for (const auto& l : c.loops) pinned |= l.cpu == cpu;
+    if (!pinned) out.push_back(cpu);
+  }
+  return out;
+}
+
 }  // namespace
 
 Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move(config)), options_(std::move(options)) {
+  // First, before anything makes a thread (a plugin's configure may): the non-RT threads' CPUs.
+  // This thread moves there, so every thread made from here on starts there; a loop pins
+  // itself to its own CPU.
+  non_rt_step_ = rt::set_non_rt_cpus(non_rt_cpus_of(config_));
+  if (non_rt_step_.applied) facts_.non_rt_cpus = rt::format_cpu_list(rt::non_rt_cpus());
   facts_.config_file = config_.file;
   std::vector<fs::path> dirs;
   for (const auto& d : options_.plugin_dirs.empty() ? config_.plugin_dirs : options_.plugin_dirs) dirs.emplace_back(d);
@@ -80,6 +98,7 @@ int Daemon::run() {
     facts_.mlockall_applied = step.applied;
     log_step(step);
   }
+  log_step(non_rt_step_);
   rt::DmaLatencyRequest dma;
   if (d.cpu_dma_latency_us) {
     const auto step = dma.request(*d.cpu_dma_latency_us);
@@ -106,6 +125,7 @@ int Daemon::run() {
     log_step(step);
   }
   figures_ = std::make_unique<FigureWatch>(host_->ports());
+  facts_.threads = thread_placements();  // the loops and the plugins' workers run by now
   facts_.sched_fifo_applied &= any_fifo;
   facts_.affinity_applied &= any_cpu;
   spdlog::info("creased running: {} loops, {} plugins, control socket {}", config_.loops.size(), config_.plugins.size(),

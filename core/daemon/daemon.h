@@ -17,6 +17,7 @@
 #include "core/daemon/report_builder.h"
 #include "core/daemon/figures.h"
 #include "core/plugin_host.h"
+#include "rt/rt_setup.h"
 
 namespace crease::daemon {
 
@@ -54,6 +55,7 @@ class Daemon final : public control::RequestHandler {
   std::unique_ptr<control::ControlServer> server_;
   std::unique_ptr<FigureWatch> figures_;     // the plugins' figures for progress and summary
   RunFacts facts_;
+  rt::SetupStep non_rt_step_;                // where the non-RT threads were placed
   std::atomic<bool> stop_{false};
   std::string stop_reason_ = "stopped";
   std::atomic<std::uint64_t> requests_{0};

@@ -11,6 +11,7 @@
 #include "core/report/from_rt.h"
 #include "core/report/render.h"
 #include "rt/clock.h"
+#include "rt/thread_placement.h"
 
 namespace crease::daemon {
 
@@ -36,6 +37,14 @@ const char* event_kind(HostEvent::Type t) {
 }
 }  // namespace
 
+std::vector<report::ThreadPlacement> thread_placements() {
+  std::vector<report::ThreadPlacement> out;
+  for (const rt::ThreadInfo& t : rt::list_threads()) {
+    out.push_back({t.name, t.tid, rt::format_cpu_list(t.cpus), t.policy, t.priority});
+  }
+  return out;
+}
+
 report::TimingReport build_report(const PluginHost& host, const RunFacts& facts) {
   report::TimingReport r;
   r.config_file = facts.config_file;
@@ -46,6 +55,8 @@ report::TimingReport build_report(const PluginHost& host, const RunFacts& facts)
   r.machine.mlockall_applied = facts.mlockall_applied;
   r.machine.affinity_applied = facts.affinity_applied;
   r.machine.sched_fifo_applied = facts.sched_fifo_applied;
+  r.machine.non_rt_cpus = facts.non_rt_cpus;
+  r.machine.threads = facts.threads;
 
   const auto instances = host.instances();
   for (const Loop* loop : host.loops()) {

@@ -16,7 +16,12 @@ struct RunFacts {
   bool mlockall_applied = false;
   bool affinity_applied = false;
   bool sched_fifo_applied = false;
+  std::string non_rt_cpus;                         // CPU list of the non-RT threads ("" = anywhere)
+  std::vector<report::ThreadPlacement> threads;    // every thread, taken once the loops run
 };
+
+// Every thread of this process now, with its placement (rt::list_threads).
+[[nodiscard]] std::vector<report::ThreadPlacement> thread_placements();
 
 [[nodiscard]] report::TimingReport build_report(const PluginHost& host, const RunFacts& facts);
 

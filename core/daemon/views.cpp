@@ -37,6 +37,14 @@ nlohmann::json loops_view(const PluginHost& host) {
   return out;
 }
 
+nlohmann::json threads_view(const RunFacts& facts) {
+  nlohmann::json threads = nlohmann::json::array();
+  for (const report::ThreadPlacement& t : thread_placements()) {
+    threads.push_back({{"name", t.name}, {"tid", t.tid}, {"cpus", t.cpus}, {"policy", t.policy}, {"priority", t.priority}});
+  }
+  return {{"non_rt_cpus", facts.non_rt_cpus.empty() ? std::string("any") : facts.non_rt_cpus}, {"threads", threads}};
+}
+
 nlohmann::json plugins_view(const PluginHost& host) {
   nlohmann::json out = nlohmann::json::array();
   for (const InstanceInfo& i : host.instances()) {

@@ -1,5 +1,5 @@
 // The JSON views of a running host that the control commands `status`, `loops`, `plugins`,
-// `ports` and `stats` answer with (field names are part of the control protocol: README.md).
+// `ports`, `threads` and `stats` answer with (field names are part of the control protocol: README.md).
 // Non-RT; the counters are read as they are now (atomics, histogram snapshots).
 #pragma once
 
@@ -19,6 +19,9 @@ namespace crease::daemon {
 [[nodiscard]] nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns);
 // Per loop: spec, cycles, overruns, wake-up and execution percentiles (us).
 [[nodiscard]] nlohmann::json loops_view(const PluginHost& host);
+// Where the non-RT threads run (daemon.non_rt_cpus), and every thread of the daemon now: name,
+// tid, CPUs (affinity), scheduling policy and priority.
+[[nodiscard]] nlohmann::json threads_view(const RunFacts& facts);
 // Per instance: plugin, library, state, counters, execution p99 (us), tunables.
 [[nodiscard]] nlohmann::json plugins_view(const PluginHost& host);
 // Per port, every kind: name, kind, type, version, size, writer, readers, and the kind's

@@ -87,6 +87,11 @@ std::string render_text(const TimingReport& r) {
   appendf(out, "# applied: sched_fifo=%s affinity=%s mlockall=%s\n",
           m.sched_fifo_applied ? "yes" : "no", m.affinity_applied ? "yes" : "no",
           m.mlockall_applied ? "yes" : "no");
+  appendf(out, "# non-real-time threads on CPUs: %s\n", m.non_rt_cpus.empty() ? "any" : m.non_rt_cpus.c_str());
+  for (const ThreadPlacement& t : m.threads) {
+    appendf(out, "# thread: %s tid=%d cpus=%s policy=%s priority=%d\n", one_line(t.name).c_str(), t.tid,
+            t.cpus.c_str(), t.policy.c_str(), t.priority);
+  }
   appendf(out, "# columns: wake-up latency per loop, one row per microsecond\n");
   for (std::size_t i = 0; i < r.loops.size(); ++i) {
     const LoopTiming& l = r.loops[i];

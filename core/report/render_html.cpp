@@ -191,6 +191,16 @@ std::string render_html(const TimingReport& r) {
   h += "<tr><th class=\"l\">SCHED_FIFO applied</th><td class=\"l\">" + yes_no(m.sched_fifo_applied) + "</td></tr>";
   h += "<tr><th class=\"l\">CPU affinity applied</th><td class=\"l\">" + yes_no(m.affinity_applied) + "</td></tr>";
   h += "<tr><th class=\"l\">mlockall applied</th><td class=\"l\">" + yes_no(m.mlockall_applied) + "</td></tr>";
+  h += "<tr><th class=\"l\">non-real-time threads on CPUs</th><td class=\"l\">" +
+       esc(m.non_rt_cpus.empty() ? std::string("any") : m.non_rt_cpus) + "</td></tr>";
+  h += "</table>\n";
+  h += "<h2>Threads</h2><table><tr><th class=\"l\">thread</th><th>tid</th><th class=\"l\">CPUs</th>"
+       "<th class=\"l\">policy</th><th>priority</th></tr>";
+  for (const ThreadPlacement& t : m.threads) {
+    h += "<tr><td class=\"l\">" + esc(t.name) + "</td><td>" + std::to_string(t.tid) + "</td><td class=\"l\">" +
+         esc(t.cpus) + "</td><td class=\"l\">" + esc(t.policy) + "</td><td>" + std::to_string(t.priority) +
+         "</td></tr>";
+  }
   h += "</table>\n";
 
   h += "<h2>Loops</h2><table><tr><th class=\"l\">loop</th><th>rate Hz</th><th>priority</th>"

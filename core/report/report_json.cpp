@@ -78,16 +78,24 @@ void from_json(const nlohmann::json& j, PortTraffic& v) {
   CREASE_J_IN(capacity) CREASE_J_IN(writes) CREASE_J_IN(dropped) CREASE_J_IN(consumed)
 }
 
+void to_json(nlohmann::json& j, const ThreadPlacement& v) {
+  j = nlohmann::json::object();
+  CREASE_J_OUT(name) CREASE_J_OUT(tid) CREASE_J_OUT(cpus) CREASE_J_OUT(policy) CREASE_J_OUT(priority)
+}
+void from_json(const nlohmann::json& j, ThreadPlacement& v) {
+  CREASE_J_IN(name) CREASE_J_IN(tid) CREASE_J_IN(cpus) CREASE_J_IN(policy) CREASE_J_IN(priority)
+}
+
 void to_json(nlohmann::json& j, const MachineInfo& v) {
   j = nlohmann::json::object();
   CREASE_J_OUT(hostname) CREASE_J_OUT(kernel) CREASE_J_OUT(cpu_model) CREASE_J_OUT(cpu_count)
   CREASE_J_OUT(preemption) CREASE_J_OUT(sched_fifo_applied) CREASE_J_OUT(affinity_applied)
-  CREASE_J_OUT(mlockall_applied)
+  CREASE_J_OUT(mlockall_applied) CREASE_J_OUT(non_rt_cpus) CREASE_J_OUT(threads)
 }
 void from_json(const nlohmann::json& j, MachineInfo& v) {
   CREASE_J_IN(hostname) CREASE_J_IN(kernel) CREASE_J_IN(cpu_model) CREASE_J_IN(cpu_count)
   CREASE_J_IN(preemption) CREASE_J_IN(sched_fifo_applied) CREASE_J_IN(affinity_applied)
-  CREASE_J_IN(mlockall_applied)
+  CREASE_J_IN(mlockall_applied) CREASE_J_IN(non_rt_cpus) CREASE_J_IN(threads)
 }
 
 void to_json(nlohmann::json& j, const TimingReport& v) {

@@ -89,6 +89,15 @@ struct PortTraffic {
   std::uint64_t consumed = 0;        // frames: sequence of the newest set the reader took
 };
 
+// One thread of the daemon and where it may run (rt::list_threads, taken once the loops run).
+struct ThreadPlacement {
+  std::string name;
+  int tid = 0;
+  std::string cpus;    // its affinity as a CPU list, e.g. "0" or "0-3"
+  std::string policy;  // fifo, rr, other, batch, idle
+  int priority = 0;
+};
+
 struct MachineInfo {
   std::string hostname;
   std::string kernel;       // uname -r + version
@@ -98,6 +107,8 @@ struct MachineInfo {
   bool sched_fifo_applied = false;
   bool affinity_applied = false;
   bool mlockall_applied = false;
+  std::string non_rt_cpus;               // where the non-real-time threads run ("" = anywhere)
+  std::vector<ThreadPlacement> threads;  // every thread of the daemon
 };
 
 // Reads hostname, kernel, CPU model and count, preemption model. The *_applied flags are

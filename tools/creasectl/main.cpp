@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
   };
   simple("status", "daemon state, uptime, loops and plugin counts");
   simple("loops", "loops with rate, priority, CPU and timing");
+  simple("threads", "every thread of the daemon: CPUs, policy, priority; where non-RT threads run");
   simple("plugins", "plugin instances with library, loop, order and state");
   simple("ports", "ports with type, writer and readers");
   simple("stats", "timing statistics and control-server counters");

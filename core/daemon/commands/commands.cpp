@@ -12,7 +12,7 @@ CommandHandler find_command(std::string_view cmd) {
       {"ports", ports_command},     {"stats", stats_command},         {"stop", stop_command},
       {"report", report_command},   {"load", load_command},           {"unload", unload_command},
       {"activate", activate_command}, {"deactivate", deactivate_command}, {"swap", swap_command},
-      {"param", param_command},
+      {"param", param_command},     {"threads", threads_command},
   };
   for (const auto& [name, handler] : kTable) {
     if (name == cmd) return handler;

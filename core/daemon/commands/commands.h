@@ -46,6 +46,7 @@ nlohmann::json reply_failed_on_error(const std::function<nlohmann::json()>& fn);
 // --- the handlers (files of this folder) ---
 nlohmann::json status_command(const nlohmann::json& request, CommandContext& ctx);   // view_commands.cpp
 nlohmann::json loops_command(const nlohmann::json& request, CommandContext& ctx);    // view_commands.cpp
+nlohmann::json threads_command(const nlohmann::json& request, CommandContext& ctx);  // view_commands.cpp
 nlohmann::json plugins_command(const nlohmann::json& request, CommandContext& ctx);  // view_commands.cpp
 nlohmann::json ports_command(const nlohmann::json& request, CommandContext& ctx);    // view_commands.cpp
 nlohmann::json stats_command(const nlohmann::json& request, CommandContext& ctx);    // view_commands.cpp

@@ -1,4 +1,4 @@
-// status, loops, plugins, ports, stats: no arguments, the views of core/daemon/views.h.
+// status, loops, threads, plugins, ports, stats: no arguments, the views of core/daemon/views.h.
 #include "core/daemon/commands/commands.h"
 #include "core/daemon/views.h"
 #include "rt/clock.h"
@@ -10,6 +10,8 @@ nlohmann::json status_command(const nlohmann::json&, CommandContext& ctx) {
 }
 
 nlohmann::json loops_command(const nlohmann::json&, CommandContext& ctx) { return loops_view(ctx.host); }
+
+nlohmann::json threads_command(const nlohmann::json&, CommandContext& ctx) { return threads_view(ctx.facts); }
 
 nlohmann::json plugins_command(const nlohmann::json&, CommandContext& ctx) { return plugins_view(ctx.host); }
 

@@ -34,6 +34,7 @@ daemon:
   lock_memory: false
   prefault_heap_mb: 16
   cpu_dma_latency_us: 0
+  non_rt_cpus: [0]
 loops:
   - name: control
     rate_hz: 1000
@@ -80,6 +81,8 @@ TEST_CASE("a complete configuration loads into plain structs with resolved paths
   CHECK_FALSE(c.daemon.lock_memory);
   CHECK(c.daemon.prefault_heap_mb == 16);
   CHECK(c.daemon.cpu_dma_latency_us.value() == 0);
+  REQUIRE(c.daemon.non_rt_cpus.has_value());
+  CHECK(*c.daemon.non_rt_cpus == std::vector<int>{0});
 
   REQUIRE(c.loops.size() == 2);
   CHECK(c.loops[0].name == "control");
@@ -87,7 +90,7 @@ TEST_CASE("a complete configuration loads into plain structs with resolved paths
   CHECK(c.loops[0].period_ns() == 1000000);
   CHECK(c.loops[0].priority == 80);
   CHECK(c.loops[0].cpu == 1);
-  CHECK(c.loops[0].loc.line == 11);
+  CHECK(c.loops[0].loc.line == 12);
   CHECK(c.loops[0].loc.column == 5);
   CHECK(c.loops[1].cpu == -1);
   CHECK(c.loops[1].period_ns() == 16666667);
@@ -99,9 +102,9 @@ TEST_CASE("a complete configuration loads into plain structs with resolved paths
   CHECK(second->enabled);
   CHECK(second->params["step"].as<int>() == 2);
   CHECK(second->params["nested"]["a"][1].as<int>() == 2);
-  CHECK(second->params_loc.line == 24);
+  CHECK(second->params_loc.line == 25);
   CHECK(second->ports.at("out") == "counter_b");
-  CHECK(second->loc.str() == "/etc/crease/sim.yaml:20:5");
+  CHECK(second->loc.str() == "/etc/crease/sim.yaml:21:5");
   CHECK(c.find_plugin("first")->library == "/etc/crease/libs/libcustom.so");
   CHECK_FALSE(c.find_plugin("first")->enabled);
   CHECK(c.find_plugin("modeller")->params.IsMap());
@@ -131,6 +134,7 @@ TEST_CASE("defaults: optional sections may be absent") {
   CHECK_FALSE(c.daemon.socket.has_value());
   CHECK_FALSE(c.daemon.duration_s.has_value());
   CHECK_FALSE(c.daemon.cpu_dma_latency_us.has_value());
+  CHECK_FALSE(c.daemon.non_rt_cpus.has_value());
   CHECK(c.daemon.lock_memory);
   CHECK(c.plugins.empty());
   CHECK(c.safety.on_fault == cfg::FaultPolicy::deactivate);
@@ -200,6 +204,12 @@ TEST_CASE("bad configurations name file, line, column, key and reason") {
        "/etc/crease/bad.yaml:1:1: (document): expected a map with plugin_dirs, loops and plugins"},
       {"port map not a map", HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 1, ports: out}\n",
        "/etc/crease/bad.yaml:7:59: plugins[0].ports: expected a map local: global"},
+      {"non_rt_cpus on a pinned loop's CPU", HEAD "    cpu: 1\ndaemon:\n  non_rt_cpus: [0, 1]\n",
+       "/etc/crease/bad.yaml:8:16: daemon.non_rt_cpus: CPU 1 is loop 'control''s own (its cpu); list the others"},
+      {"non_rt_cpus empty", HEAD "daemon:\n  non_rt_cpus: []\n",
+       "/etc/crease/bad.yaml:7:16: daemon.non_rt_cpus: expected a non-empty list of CPU indices, e.g. [0]"},
+      {"non_rt_cpus out of range", HEAD "daemon:\n  non_rt_cpus: [0, 4096]\n",
+       "/etc/crease/bad.yaml:7:20: daemon.non_rt_cpus[1]: must be in [0, 1023], got 4096"},
       {"socket is a list", HEAD "daemon:\n  socket: [a]\n",
        "/etc/crease/bad.yaml:7:11: daemon.socket: expected a string, got a list"},
       {"duplicate key inside params",

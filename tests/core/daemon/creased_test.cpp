@@ -2,6 +2,7 @@
 // parameter, reads reports in every format and stops it. Bad configurations exit 2 before
 // anything starts (no socket, no report).
 #include <doctest/doctest.h>
+#include <sched.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +14,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/control/control_client.h"
 
@@ -154,6 +156,94 @@ TEST_CASE("creased runs, creasectl steers it, reports come out in every format")
   // After it stopped, creasectl says so and exits non-zero.
   auto gone = sh(ctl + "status");
   CHECK(gone.status != 0);
+}
+
+// The control loop pinned to the last CPU: every other thread of the daemon (control server,
+// log drain, the host) stays off it, and `threads` and the report say where each one runs.
+TEST_CASE("non-real-time threads stay off a pinned loop's CPU; threads view and report show it") {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  REQUIRE(sched_getaffinity(0, sizeof(set), &set) == 0);
+  std::vector<int> cpus;
+  for (int c = 0; c < CPU_SETSIZE; ++c)
+    if (CPU_ISSET(c, &set)) cpus.push_back(c);
+  REQUIRE(cpus.size() >= 2);  // a machine of one CPU cannot keep a CPU for the loop
+  const int rt_cpu = cpus.back();
+  std::string others;
+  for (std::size_t i = 0; i + 1 < cpus.size(); ++i) others += (others.empty() ? "" : ",") + std::to_string(cpus[i]);
+  if (cpus.size() > 2 && cpus[cpus.size() - 2] - cpus.front() == static_cast<int>(cpus.size()) - 2) {
+    others = std::to_string(cpus.front()) + "-" + std::to_string(cpus[cpus.size() - 2]);
+  }
+
+  TempDir tmp;
+  const fs::path cfg = tmp.path / "pinned.yaml";
+  std::ofstream(cfg) << std::string("plugin_dirs: [") + CREASE_PLUGIN_DIR + "]\n"
+                     << "loops:\n  - {name: control, rate_hz: 1000, priority: 0, cpu: " << rt_cpu << "}\n"
+                     << "plugins:\n  - {name: counter, library: crease_test_counter_v1, loop: control, order: 1}\n";
+  const std::string sock = (tmp.path / "creased.sock").string();
+  const fs::path reports = tmp.path / "reports";
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const std::string out = (tmp.path / "creased.log").string();
+    std::freopen(out.c_str(), "w", stdout);
+    std::freopen(out.c_str(), "a", stderr);
+    execl((kBin + "/creased").c_str(), "creased", "--config", cfg.c_str(), "--socket", sock.c_str(), "--report-dir",
+          reports.c_str(), "--duration", "60", "--no-progress", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  bool up = false;
+  for (int i = 0; i < 400 && !up; ++i) {
+    std::this_thread::sleep_for(25ms);
+    up = fs::exists(sock);
+  }
+  REQUIRE(up);
+  {
+    crease::control::ControlClient client(sock);
+    // The socket listens before the loops start: ask until the loop's thread is there.
+    nlohmann::json r;
+    for (int i = 0; i < 400; ++i) {
+      r = client.request({{"cmd", "threads"}});
+      if (r["result"]["threads"].dump().find("crease-control") != std::string::npos) break;
+      std::this_thread::sleep_for(25ms);
+    }
+    REQUIRE(r["ok"] == true);
+    CHECK(r["result"]["non_rt_cpus"] == others);
+    bool saw_loop = false, saw_io = false, saw_work = false;
+    for (const auto& t : r["result"]["threads"]) {
+      CAPTURE(t.dump());
+      const std::string name = t["name"];
+      if (name == "crease-control") {
+        saw_loop = true;
+        CHECK(t["cpus"] == std::to_string(rt_cpu));
+        continue;
+      }
+      saw_io |= name == "crease-ctl-io";
+      saw_work |= name == "crease-ctl-work";
+      CHECK(t["cpus"] == others);  // every other thread: main, control server, log drain, ...
+    }
+    CHECK(saw_loop);
+    CHECK(saw_io);
+    CHECK(saw_work);
+  }
+  const auto human = sh(kBin + "/creasectl --socket " + sock + " threads");
+  CHECK(human.status == 0);
+  CHECK(human.out.find("crease-ctl-io") != std::string::npos);
+  CHECK(sh(kBin + "/creasectl --socket " + sock + " stop").status == 0);
+  int wstatus = 0;
+  for (int i = 0; i < 200; ++i) {
+    if (waitpid(pid, &wstatus, WNOHANG) == pid) break;
+    std::this_thread::sleep_for(25ms);
+  }
+  REQUIRE(WIFEXITED(wstatus));
+  const auto report = nlohmann::json::parse(slurp(reports / "report.json"));
+  CHECK(report["machine"]["non_rt_cpus"] == others);
+  bool reported_loop = false;
+  for (const auto& t : report["machine"]["threads"]) {
+    if (t["name"] == "crease-control") reported_loop = t["cpus"] == std::to_string(rt_cpu);
+  }
+  CHECK(reported_loop);
+  CHECK(slurp(reports / "report.txt").find("# non-real-time threads on CPUs: " + others) != std::string::npos);
 }
 
 TEST_CASE("bad configurations exit 2 with file, line and key, and start nothing") {
