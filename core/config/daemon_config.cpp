@@ -139,18 +139,6 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
   }
 }
 
-// A pinned loop's CPU is the loop's alone: non_rt_cpus may not list it.
-void check_non_rt_cpus(const DaemonConfig& cfg) {
-  if (!cfg.daemon.non_rt_cpus) return;
-  for (int c : *cfg.daemon.non_rt_cpus) {
-    for (const LoopConfig& l : cfg.loops) {
-      if (l.cpu == c) {
-        throw ConfigError(cfg.daemon.non_rt_cpus_loc, "daemon.non_rt_cpus",
-                          "CPU " + std::to_string(c) + " is loop '" + l.name + "''s own (its cpu); list the others");
-      }
-    }
-  }
-}
 
 void read_loops(const MapReader& root, DaemonConfig& cfg) {
   const std::string& f = root.file();
@@ -361,7 +349,6 @@ DaemonConfig load_daemon_config_from_string(const std::string& text,
   read_plugin_dirs(root, options, cfg);
   read_daemon(root, cfg);
   read_loops(root, cfg);
-  check_non_rt_cpus(cfg);
   read_plugins(root, cfg);
   read_safety(root, cfg);
   return cfg;

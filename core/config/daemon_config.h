@@ -40,7 +40,8 @@ struct DaemonSettings {
   int prefault_heap_mb = 64;                // >= 0, heap touched at start when lock_memory
   std::optional<int> cpu_dma_latency_us;    // >= 0; absent: /dev/cpu_dma_latency untouched
   // CPUs for every non-real-time thread (control server, log drain, host polling, workers);
-  // absent: every CPU of the process that no loop is pinned to. Never a pinned loop's CPU.
+  // absent: every CPU of the process that no loop is pinned to. A listed CPU that a loop is
+  // pinned to is shared with that loop (creased says so at start): e.g. a simulated world's.
   std::optional<std::vector<int>> non_rt_cpus;
   SourceLoc non_rt_cpus_loc;
   SourceLoc loc;

@@ -62,6 +62,11 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
   // This thread moves there, so every thread made from here on starts there; a loop pins
   // itself to its own CPU.
   non_rt_step_ = rt::set_non_rt_cpus(non_rt_cpus_of(config_));
+  for (const auto& l : config_.loops) {
+    for (int c : rt::non_rt_cpus()) {
+      if (non_rt_step_.applied && l.cpu == c) non_rt_step_.what += "; shared with loop '" + l.name + "'";
+    }
+  }
   if (non_rt_step_.applied) facts_.non_rt_cpus = rt::format_cpu_list(rt::non_rt_cpus());
   facts_.config_file = config_.file;
   std::vector<fs::path> dirs;

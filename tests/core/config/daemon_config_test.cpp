@@ -204,8 +204,6 @@ TEST_CASE("bad configurations name file, line, column, key and reason") {
        "/etc/crease/bad.yaml:1:1: (document): expected a map with plugin_dirs, loops and plugins"},
       {"port map not a map", HEAD "plugins:\n  - {name: a, library: x, loop: control, order: 1, ports: out}\n",
        "/etc/crease/bad.yaml:7:59: plugins[0].ports: expected a map local: global"},
-      {"non_rt_cpus on a pinned loop's CPU", HEAD "    cpu: 1\ndaemon:\n  non_rt_cpus: [0, 1]\n",
-       "/etc/crease/bad.yaml:8:16: daemon.non_rt_cpus: CPU 1 is loop 'control''s own (its cpu); list the others"},
       {"non_rt_cpus empty", HEAD "daemon:\n  non_rt_cpus: []\n",
        "/etc/crease/bad.yaml:7:16: daemon.non_rt_cpus: expected a non-empty list of CPU indices, e.g. [0]"},
       {"non_rt_cpus out of range", HEAD "daemon:\n  non_rt_cpus: [0, 4096]\n",
