@@ -68,6 +68,30 @@ std::string slurp(const fs::path& p) {
   s << f.rdbuf();
   return s.str();
 }
+// Starts creased on CFG (its output in DIR/creased.log) with a socket and a report folder, a
+// 60 s bound; returns its pid.
+pid_t start_creased(const fs::path& dir, const fs::path& cfg, const std::string& sock, const fs::path& reports) {
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    const std::string out = (dir / "creased.log").string();
+    std::freopen(out.c_str(), "w", stdout);
+    std::freopen(out.c_str(), "a", stderr);
+    execl((kBin + "/creased").c_str(), "creased", "--config", cfg.c_str(), "--socket", sock.c_str(), "--report-dir",
+          reports.c_str(), "--duration", "60", "--no-progress", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits (at most 10 s) until SOCK exists.
+bool wait_for_socket(const std::string& sock) {
+  for (int i = 0; i < 400; ++i) {
+    if (fs::exists(sock)) return true;
+    std::this_thread::sleep_for(25ms);
+  }
+  return fs::exists(sock);
+}
 }  // namespace
 
 TEST_CASE("creased runs, creasectl steers it, reports come out in every format") {
@@ -76,22 +100,8 @@ TEST_CASE("creased runs, creasectl steers it, reports come out in every format")
   std::ofstream(cfg) << config_text();
   const std::string sock = (tmp.path / "creased.sock").string();
   const fs::path reports = tmp.path / "reports";
-  const pid_t pid = fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    const std::string out = (tmp.path / "creased.log").string();
-    std::freopen(out.c_str(), "w", stdout);
-    std::freopen(out.c_str(), "a", stderr);
-    execl((kBin + "/creased").c_str(), "creased", "--config", cfg.c_str(), "--socket", sock.c_str(), "--report-dir",
-          reports.c_str(), "--duration", "60", "--no-progress", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  bool up = false;
-  for (int i = 0; i < 200 && !up; ++i) {
-    std::this_thread::sleep_for(25ms);
-    up = fs::exists(sock);
-  }
-  REQUIRE(up);
+  const pid_t pid = start_creased(tmp.path, cfg, sock, reports);
+  REQUIRE(wait_for_socket(sock));
   struct stat st {};
   REQUIRE(::stat(sock.c_str(), &st) == 0);
   CHECK((st.st_mode & 0777) == 0600);
@@ -182,22 +192,8 @@ TEST_CASE("non-real-time threads stay off a pinned loop's CPU; threads view and 
                      << "plugins:\n  - {name: counter, library: crease_test_counter_v1, loop: control, order: 1}\n";
   const std::string sock = (tmp.path / "creased.sock").string();
   const fs::path reports = tmp.path / "reports";
-  const pid_t pid = fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    const std::string out = (tmp.path / "creased.log").string();
-    std::freopen(out.c_str(), "w", stdout);
-    std::freopen(out.c_str(), "a", stderr);
-    execl((kBin + "/creased").c_str(), "creased", "--config", cfg.c_str(), "--socket", sock.c_str(), "--report-dir",
-          reports.c_str(), "--duration", "60", "--no-progress", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  bool up = false;
-  for (int i = 0; i < 400 && !up; ++i) {
-    std::this_thread::sleep_for(25ms);
-    up = fs::exists(sock);
-  }
-  REQUIRE(up);
+  const pid_t pid = start_creased(tmp.path, cfg, sock, reports);
+  REQUIRE(wait_for_socket(sock));
   {
     crease::control::ControlClient client(sock);
     // The socket listens before the loops start: ask until the loop's thread is there.
