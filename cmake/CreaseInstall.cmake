@@ -54,7 +54,8 @@ install(DIRECTORY ${CMAKE_SOURCE_DIR}/config/ DESTINATION ${CREASE_INSTALL_DATAD
         FILE_PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ
         PATTERN "creased.service" EXCLUDE REGEX "/config/[^/]*\\.yaml$" EXCLUDE)
 # The robot's own configuration goes to /etc/crease with what it reads (cameras, markers, robot).
-foreach(sub cameras markers robot dds)
+set(CREASE_ETC_SUBDIRS cameras markers robot dds)  # what robot.yaml reads; conffiles too
+foreach(sub ${CREASE_ETC_SUBDIRS})
   install(DIRECTORY ${CMAKE_SOURCE_DIR}/config/${sub} DESTINATION ${CREASE_INSTALL_CONFDIR} COMPONENT runtime
           FILE_PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ)
 endforeach()

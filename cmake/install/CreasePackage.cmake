@@ -22,7 +22,7 @@ set(CPACK_DEBIAN_PACKAGE_DEPENDS "adduser")
 
 # Conffiles: every file under /etc/crease (dpkg keeps a lab's edits on upgrade).
 set(conffiles "${CREASE_INSTALL_CONFDIR}/robot.yaml\n")
-foreach(sub cameras markers robot dds)
+foreach(sub ${CREASE_ETC_SUBDIRS})
   file(GLOB_RECURSE files RELATIVE ${CMAKE_SOURCE_DIR}/config ${CMAKE_SOURCE_DIR}/config/${sub}/*)
   foreach(f ${files})
     string(APPEND conffiles "${CREASE_INSTALL_CONFDIR}/${f}\n")

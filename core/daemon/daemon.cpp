@@ -2,6 +2,7 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -61,13 +62,16 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
   // First, before anything makes a thread (a plugin's configure may): the non-RT threads' CPUs.
   // This thread moves there, so every thread made from here on starts there; a loop pins
   // itself to its own CPU.
-  non_rt_step_ = rt::set_non_rt_cpus(non_rt_cpus_of(config_));
-  for (const auto& l : config_.loops) {
-    for (int c : rt::non_rt_cpus()) {
-      if (non_rt_step_.applied && l.cpu == c) non_rt_step_.what += "; shared with loop '" + l.name + "'";
+  const std::vector<int> non_rt = non_rt_cpus_of(config_);
+  non_rt_step_ = rt::set_non_rt_cpus(non_rt);
+  if (non_rt_step_.applied) {
+    facts_.non_rt_cpus = rt::format_cpu_list(non_rt);
+    for (const auto& l : config_.loops) {
+      if (std::find(non_rt.begin(), non_rt.end(), l.cpu) != non_rt.end()) {
+        non_rt_step_.what += "; shared with loop '" + l.name + "'";
+      }
     }
   }
-  if (non_rt_step_.applied) facts_.non_rt_cpus = rt::format_cpu_list(rt::non_rt_cpus());
   facts_.config_file = config_.file;
   std::vector<fs::path> dirs;
   for (const auto& d : options_.plugin_dirs.empty() ? config_.plugin_dirs : options_.plugin_dirs) dirs.emplace_back(d);

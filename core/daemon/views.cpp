@@ -1,4 +1,5 @@
 #include "core/daemon/views.h"
+#include "core/report/report_json.h"
 
 namespace crease::daemon {
 namespace {
@@ -38,11 +39,8 @@ nlohmann::json loops_view(const PluginHost& host) {
 }
 
 nlohmann::json threads_view(const RunFacts& facts) {
-  nlohmann::json threads = nlohmann::json::array();
-  for (const report::ThreadPlacement& t : thread_placements()) {
-    threads.push_back({{"name", t.name}, {"tid", t.tid}, {"cpus", t.cpus}, {"policy", t.policy}, {"priority", t.priority}});
-  }
-  return {{"non_rt_cpus", facts.non_rt_cpus.empty() ? std::string("any") : facts.non_rt_cpus}, {"threads", threads}};
+  return {{"non_rt_cpus", facts.non_rt_cpus.empty() ? std::string("any") : facts.non_rt_cpus},
+          {"threads", thread_placements()}};  // as the report's machine section (report_json.h)
 }
 
 nlohmann::json plugins_view(const PluginHost& host) {

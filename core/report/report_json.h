@@ -22,6 +22,8 @@ void to_json(nlohmann::json& j, const Event& v);
 void from_json(const nlohmann::json& j, Event& v);
 void to_json(nlohmann::json& j, const PortTraffic& v);
 void from_json(const nlohmann::json& j, PortTraffic& v);
+void to_json(nlohmann::json& j, const ThreadPlacement& v);
+void from_json(const nlohmann::json& j, ThreadPlacement& v);
 void to_json(nlohmann::json& j, const MachineInfo& v);
 void from_json(const nlohmann::json& j, MachineInfo& v);
 void to_json(nlohmann::json& j, const TimingReport& v);

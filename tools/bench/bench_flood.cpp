@@ -135,7 +135,6 @@ int run(int argc, char** argv) {
   flooding.store(false);
   done.store(true);
   for (auto& t : threads) t.join();
-  const double elapsed = flood_s;
   daemon.request_stop();
   runner.join();
   std::filesystem::remove_all(dir);
@@ -150,7 +149,7 @@ int run(int argc, char** argv) {
   const double p99_ratio = double(flood.percentile(99)) / std::max<double>(1000.0, double(quiet.percentile(99)));
   const double p999_ratio = double(flood.percentile(99.9)) / std::max<double>(1000.0, double(quiet.percentile(99.9)));
   std::printf("  requests: %llu in %.1f s of flood (%.0f/s), busy: %llu, failed: %llu\n", (unsigned long long)sent.load(),
-              elapsed, double(sent.load()) / elapsed, (unsigned long long)busy.load(), (unsigned long long)errors.load());
+              flood_s, double(sent.load()) / flood_s, (unsigned long long)busy.load(), (unsigned long long)errors.load());
   std::printf("flood: p99_ratio=%.2f p999_ratio=%.2f requests=%llu errors=%llu\n", p99_ratio, p999_ratio,
               (unsigned long long)sent.load(), (unsigned long long)errors.load());
   return errors.load() == 0 ? 0 : 1;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/control/control_client.h"
+#include "rt/thread_placement.h"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -179,11 +180,7 @@ TEST_CASE("non-real-time threads stay off a pinned loop's CPU; threads view and 
     if (CPU_ISSET(c, &set)) cpus.push_back(c);
   REQUIRE(cpus.size() >= 2);  // a machine of one CPU cannot keep a CPU for the loop
   const int rt_cpu = cpus.back();
-  std::string others;
-  for (std::size_t i = 0; i + 1 < cpus.size(); ++i) others += (others.empty() ? "" : ",") + std::to_string(cpus[i]);
-  if (cpus.size() > 2 && cpus[cpus.size() - 2] - cpus.front() == static_cast<int>(cpus.size()) - 2) {
-    others = std::to_string(cpus.front()) + "-" + std::to_string(cpus[cpus.size() - 2]);
-  }
+  const std::string others = crease::rt::format_cpu_list({cpus.begin(), cpus.end() - 1});  // rt.thread_placement tests it
 
   TempDir tmp;
   const fs::path cfg = tmp.path / "pinned.yaml";
