@@ -12,7 +12,7 @@ namespace crease {
 
 struct Tactile {
   static constexpr char kPortType[] = "crease.Tactile";
-  static constexpr std::uint32_t kPortVersion = 1;
+  static constexpr std::uint32_t kPortVersion = 2;  // 2: the link's counters
   static constexpr int kFingertips = 5;
   static constexpr int kTaxels = 34;
 
@@ -22,7 +22,10 @@ struct Tactile {
   std::uint8_t valid = 0;             // bit f: fingertip f delivered data
   std::uint8_t fresh = 0;             // 1: a new sample arrived this cycle
   DeviceHealth health = DeviceHealth::fault;
-  std::int64_t age_ns = 0;            // cycle time minus timestamp_ns
+  std::int64_t age_ns = 0;            // cycle time minus timestamp_ns (0 when not positive)
+  std::uint64_t frames = 0;           // samples taken from the link so far
+  std::uint64_t crc_errors = 0;       // frames the link dropped for a bad CRC or bad COBS
+  std::uint64_t overruns = 0;         // samples dropped before the loop took them (its reader's queue full)
   float pressure_kpa[kFingertips][kTaxels] = {};
 
   [[nodiscard]] bool all_finite() const {
@@ -33,6 +36,6 @@ struct Tactile {
   }
 };
 
-CREASE_PORT_PAYLOAD_LAYOUT(Tactile, 712, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(Tactile, 736, 8);
 
 }  // namespace crease

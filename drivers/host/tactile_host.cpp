@@ -24,13 +24,17 @@ bool TactileHost::read_from_rt(std::int64_t now_ns) noexcept {
   return got;
 }
 
-LinkHealth TactileHost::health(std::int64_t now_ns) const noexcept {
-  if (samples_ == 0 || now_ns - rx_ns_ > cfg_.max_age_ns) return LinkHealth::fault;
-  if (link_.rx_stats().crc_errors + link_.rx_stats().cobs_errors > 0 &&
-      now_ns - rx_ns_ > 2 * 1'000'000'000 / (cfg_.rate_hz ? cfg_.rate_hz : 1)) {
+LinkHealth tactile_health(const TactileHostConfig& cfg, std::uint64_t samples, std::int64_t rx_ns,
+                          std::uint64_t framing_errors, std::int64_t now_ns) noexcept {
+  if (samples == 0 || now_ns - rx_ns > cfg.max_age_ns) return LinkHealth::fault;
+  if (framing_errors > 0 && now_ns - rx_ns > 2 * 1'000'000'000 / (cfg.rate_hz ? cfg.rate_hz : 1)) {
     return LinkHealth::degraded;
   }
   return LinkHealth::ok;
+}
+
+LinkHealth TactileHost::health(std::int64_t now_ns) const noexcept {
+  return tactile_health(cfg_, samples_, rx_ns_, link_.rx_stats().crc_errors + link_.rx_stats().cobs_errors, now_ns);
 }
 
 }  // namespace crease::drivers

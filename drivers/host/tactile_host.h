@@ -1,6 +1,9 @@
 // TactileHost: the controller side of the tactile matrix on a serial link (drivers/README.md
 // §6). It sends Start (and repeats it while no sample arrives), keeps the newest sample and
-// reports its age; stale beyond max_age_ns means fault. RT-safe.
+// reports its age; stale beyond max_age_ns means fault. No allocation, but read_from_rt reads
+// and writes the tty where it is called, and a tty's non-blocking read can stay in the kernel
+// for milliseconds: a loop's update reads through TactileReader (tactile_reader.h) instead,
+// whose thread does the I/O. Tests and tools that own their timing use this directly.
 #pragma once
 
 #include "drivers/host/link_monitor.h"
@@ -14,6 +17,12 @@ struct TactileHostConfig {
   std::int64_t max_age_ns = 20'000'000;  // older than this: fault
   std::int64_t start_retry_ns = 100'000'000;
 };
+
+// The health of a tactile link (TactileHost's and TactileReader's): no sample yet, or the
+// newest received more than max_age_ns before now: fault; framing errors (CRC or COBS) seen and
+// no sample for two sample periods: degraded; else ok. RT-safe.
+[[nodiscard]] LinkHealth tactile_health(const TactileHostConfig& cfg, std::uint64_t samples, std::int64_t rx_ns,
+                                        std::uint64_t framing_errors, std::int64_t now_ns) noexcept;
 
 class TactileHost {
  public:

@@ -1,8 +1,11 @@
 // Plugin `hand_driver`: one 20-joint hand over CAN FD (and, optionally, its tactile matrix
-// over serial) in the 1 kHz control loop. Non-blocking I/O only.
+// over serial) in the 1 kHz control loop. Non-blocking CAN I/O in the loop; the serial tactile
+// link is read and written by a thread of its own (drivers/host/tactile_reader.h: a tty's
+// non-blocking read can stay in the kernel for milliseconds), update only takes its samples.
 //   input  hand_command (latest HandCommand)
 //   output hand_state   (latest HandState: positions, health, freshness, acks)
-//   output tactile      (latest Tactile, when `tactile_device` is set)
+//   output tactile      (latest Tactile, when `tactile_device` is set: the newest sample, its
+//                       age and health, the link's frames, CRC errors and overruns)
 // Parameters:
 //   bus_kind        "mock" (user-space bus, default) or "socketcan"
 //   bus             mock bus name, or the SocketCAN interface (e.g. can0)        required
@@ -15,7 +18,10 @@
 //   tactile_rate_hz 1..1000 (default 250)
 //   timeout_cycles  cycles without a fresh status before fault (default 2)
 //   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
-// Cycle phases: update reads the bus and publishes hand_state / tactile; write sends the newest
+// Threads: the tactile link's reader thread ("crease-tactile", on the non-RT CPUs) runs from
+// activate to deactivate: it sends Start, deframes and decodes, and queues every sample.
+// Cycle phases: update reads the bus, takes the queued tactile samples and publishes
+// hand_state / tactile; write sends the newest
 // hand_command, so a controller that runs after the driver in the loop has its command sent in
 // the same cycle as the status it was built from.
 // A link fault (device silent, bus-off, CRC errors, emergency) commands the safe state (hold,
@@ -31,7 +37,9 @@
 #include "drivers/host/bus_prefix.h"
 #include "drivers/host/device_port_glue.h"
 #include "drivers/host/hand_host.h"
-#include "drivers/host/tactile_host.h"
+#include "drivers/host/tactile_reader.h"
+#include "drivers/serial/serial_io.h"
+#include "drivers/serial/serial_port.h"
 
 namespace {
 using namespace crease;
@@ -59,14 +67,23 @@ class HandDriver final : public Plugin {
       }
       dr::TactileHostConfig tc;
       tc.rate_hz = static_cast<std::uint16_t>(p.get_in_range<int>("tactile_rate_hz", 250, 1, 1000));
-      tactile_host_ = std::make_unique<dr::TactileHost>(serial_->fd(), tc);
+      tactile_ = std::make_unique<dr::TactileReader>(std::make_unique<dr::FdSerialIo>(serial_->fd()), tc, "crease-tactile");
       tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
     }
     command_ = ports.latest_input<HandCommand>("hand_command");
     state_out_ = ports.latest_output<HandState>("hand_state", HandState{});
   }
 
-  // Read phase: the bus and the tactile link; publishes hand_state and tactile for the
+  // Non-RT: the tactile link's thread runs while the instance is scheduled.
+  void activate() override {
+    if (tactile_) tactile_->start();
+  }
+  void deactivate() override {
+    if (tactile_) tactile_->stop();
+  }
+
+  // Read phase: the bus and the samples the tactile thread queued (no syscall on the serial
+  // link here); publishes hand_state and tactile for the
   // controllers that run after this plugin's update in the same cycle.
   Status update(const Cycle& cycle) override {
     const std::int64_t now = cycle.time_ns;
@@ -83,20 +100,25 @@ class HandDriver final : public Plugin {
     state_out_.write(state_, now);
 
     Status status = dr::to_plugin_status(host_->health());
-    if (tactile_host_) {
-      const bool got = tactile_host_->read_from_rt(now);
-      const dr::tactile::Sample& s = tactile_host_->sample();
-      tactile_.timestamp_ns = tactile_host_->sample_rx_ns();
-      tactile_.device_time_us = s.device_time_us;
-      tactile_.sample_counter = s.sample_counter;
-      tactile_.valid = s.valid;
-      tactile_.fresh = got ? 1 : 0;
-      tactile_.health = dr::to_device_health(tactile_host_->health(now));
-      tactile_.age_ns = tactile_host_->samples() ? now - tactile_.timestamp_ns : 0;
+    if (tactile_) {
+      const bool got = tactile_->take_rt();
+      const dr::tactile::Sample& s = tactile_->sample();
+      tactile_out_value_.timestamp_ns = tactile_->sample_rx_ns();
+      tactile_out_value_.device_time_us = s.device_time_us;
+      tactile_out_value_.sample_counter = s.sample_counter;
+      tactile_out_value_.valid = s.valid;
+      tactile_out_value_.fresh = got ? 1 : 0;
+      tactile_out_value_.health = dr::to_device_health(tactile_->health(now));
+      const std::int64_t age = now - tactile_out_value_.timestamp_ns;  // the thread may stamp after the cycle's time
+      tactile_out_value_.age_ns = tactile_->samples() && age > 0 ? age : 0;
+      const dr::TactileCounters c = tactile_->counters();
+      tactile_out_value_.frames = tactile_->samples();
+      tactile_out_value_.crc_errors = c.crc_errors;
+      tactile_out_value_.overruns = c.overruns;
       for (int f = 0; f < Tactile::kFingertips; ++f)
-        for (int t = 0; t < Tactile::kTaxels; ++t) tactile_.pressure_kpa[f][t] = s.pressure_kpa[f][t];
-      tactile_out_.write(tactile_, now);
-      if (tactile_.health != DeviceHealth::ok) status = Status::degraded;
+        for (int t = 0; t < Tactile::kTaxels; ++t) tactile_out_value_.pressure_kpa[f][t] = s.pressure_kpa[f][t];
+      tactile_out_.write(tactile_out_value_, now);
+      if (tactile_out_value_.health != DeviceHealth::ok) status = Status::degraded;
     }
     return status;
   }
@@ -124,12 +146,12 @@ class HandDriver final : public Plugin {
   std::unique_ptr<dr::CanBus> bus_;
   std::unique_ptr<dr::HandHost> host_;
   std::unique_ptr<dr::SerialPort> serial_;
-  std::unique_ptr<dr::TactileHost> tactile_host_;
+  std::unique_ptr<dr::TactileReader> tactile_;  // after serial_: stopped before the port closes
   LatestInput<HandCommand> command_;
   LatestOutput<HandState> state_out_;
   LatestOutput<Tactile> tactile_out_;
   HandState state_;
-  Tactile tactile_;
+  Tactile tactile_out_value_;
 };
 }  // namespace
 

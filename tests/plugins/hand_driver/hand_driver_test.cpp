@@ -8,12 +8,16 @@
 #include <thread>
 
 #include "core/port_types/hand.h"
+#include "core/port_types/tactile.h"
 #include "drivers/can/mock_can_broker.h"
 #include "drivers/can/mock_can_bus.h"
 #include "drivers/host/bus_prefix.h"
 #include "drivers/simdevice/device_thread.h"
 #include "drivers/simdevice/sense_to_command_tap.h"
 #include "drivers/simdevice/sim_hand.h"
+#include "drivers/simdevice/sim_tactile.h"
+#include "drivers/serial/serial_port.h"
+#include "rt/thread_placement.h"
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
 #include "tests/drivers/hil/tapped_driver_rig.h"
@@ -182,4 +186,83 @@ TEST_CASE("hand_driver: a status received in cycle k is answered by a command bu
                     << tap.commands_with_lag(2) << ", more: " << tap.commands_with_lag(3));
   CHECK(tap.typical_lag() == 0);
   CHECK(tap.commands_with_lag(0) * 2 > counted());
+}
+
+namespace {
+// The hand of the first test with a tactile link on a pty: `tactile_device` is its slave.
+struct TactileRig {
+  std::string bus = "plug-hand-tac-" + std::to_string(::getpid());
+  dr::MockCanBroker broker{{bus, 1'000'000, 5'000'000, false}};
+  dr::MockCanBus dev_bus{{bus, 1, 1'000'000, 5'000'000}};
+  dr::sim::SimHand hand{dev_bus, {.node = 1}};
+  dr::sim::DeviceThread dev{dev_bus.fd(), [this](std::int64_t t) { hand.step(t); }};
+  dr::PtyPair pty;
+  Rig rig{"hand_r", "hand_driver", "hand_state"};
+  TactileRig() { rig.add("{bus: " + bus + ", node: 1, tactile_device: " + pty.slave_path() + "}"); }
+  Tactile tactile() {
+    Tactile v{};
+    const auto* ch = rig.host.ports().find_latest("tactile");
+    REQUIRE(ch != nullptr);
+    ch->read(&v, 0);
+    return v;
+  }
+};
+}  // namespace
+
+// Nobody answers on the tactile link (the pty's master is never read or written): the link's
+// thread waits in its read, the loop runs on and reports the link as faulted.
+TEST_CASE("hand_driver: a tactile link nobody serves does not hold up the loop; its reader is a named non-RT thread") {
+  TactileRig t;
+  t.rig.host.start();
+  HandState s = t.rig.wait_for([](const HandState& v) { return v.health == DeviceHealth::ok && v.commands_sent > 500; });
+  CHECK(s.commands_sent > 500);  // cycles went on
+  const Tactile tac = t.tactile();
+  CHECK(tac.health == DeviceHealth::fault);
+  CHECK(tac.frames == 0);
+  const auto allocs = rt::rt_allocation_count();
+  const auto sent = t.rig.state().commands_sent;
+  REQUIRE(eventually([&] { return t.rig.state().commands_sent > sent + 200; }));
+  CHECK(rt::rt_allocation_count() == allocs);
+  bool found = false;
+  for (const rt::ThreadInfo& th : rt::list_threads()) {
+    if (th.name != "crease-tactile") continue;
+    found = true;
+    CHECK(th.policy == "other");  // not the loop's SCHED_FIFO (where the test may grant it)
+  }
+  CHECK(found);
+  // The Start it sent is waiting in the pty for a sensor.
+  std::uint8_t buf[64];
+  CHECK(::read(t.pty.master_fd(), buf, sizeof buf) > 0);
+  t.rig.host.stop();
+  for (const rt::ThreadInfo& th : rt::list_threads()) CHECK(th.name != "crease-tactile");  // stopped with the instance
+}
+
+// The sensor at its default 250 Hz on the pty: the port's samples come in order, and every
+// sample the sensor sent over the run was taken or counted as an overrun.
+TEST_CASE("hand_driver: tactile samples at the sensor's rate reach the port in order, none lost") {
+  TactileRig t;
+  dr::sim::SimTactile sensor(t.pty.master_fd());
+  dr::sim::DeviceThread sdev(t.pty.master_fd(), [&](std::int64_t now) { sensor.step(now); });
+  sensor.set_contact_force(2, 1.0f);
+  t.rig.host.start();
+  REQUIRE(eventually([&] { return t.tactile().frames > 0; }));
+  const Tactile first = t.tactile();
+  Tactile last = first;
+  std::uint64_t out_of_order = 0;
+  REQUIRE(eventually([&] {
+    const Tactile v = t.tactile();
+    if (static_cast<std::int16_t>(v.sample_counter - last.sample_counter) < 0 || v.frames < last.frames) ++out_of_order;
+    last = v;
+    return v.frames >= first.frames + 500;
+  }));
+  t.rig.host.stop();
+  CHECK(out_of_order == 0);
+  CHECK(last.health == DeviceHealth::ok);
+  CHECK(last.crc_errors == 0);
+  CHECK(last.pressure_kpa[2][16] > 5.0f);  // ~10 kPa at the centre for 1 N
+  CHECK(last.pressure_kpa[0][16] == 0.0f);
+  // Every sample between the two looks: taken or dropped for a full queue, none vanished.
+  const auto sent = static_cast<std::uint16_t>(last.sample_counter - first.sample_counter);
+  CHECK(sent == static_cast<std::uint16_t>((last.frames - first.frames) + (last.overruns - first.overruns)));
+  MESSAGE("samples " << last.frames - first.frames << ", overruns " << last.overruns - first.overruns);
 }

@@ -1,0 +1,239 @@
+// TactileReader: the tactile link served by its own thread. A fake serial link whose reads
+// block until the test hands it bytes: the RT side keeps returning while the reader is blocked,
+// never touches the link itself, and takes every sample in order.
+#include "drivers/host/tactile_reader.h"
+
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "rt/alloc_guard.h"
+#include "rt/clock.h"
+
+using namespace crease::drivers;
+
+namespace {
+
+// Reads block (ignoring the timeout) until the test gives bytes or wake() is called; every
+// call records its thread.
+class FakeLink final : public SerialIo {
+ public:
+  long read_wait(std::span<std::uint8_t> buf, int) override {
+    std::unique_lock l(m_);
+    note_thread();
+    ++waiting_;
+    cv_.notify_all();
+    cv_.wait(l, [&] { return woken_ || !chunks_.empty(); });
+    --waiting_;
+    woken_ = false;
+    if (chunks_.empty()) return 0;
+    std::vector<std::uint8_t>& c = chunks_.front();
+    const std::size_t n = std::min(c.size(), buf.size());
+    std::copy(c.begin(), c.begin() + static_cast<long>(n), buf.begin());
+    c.erase(c.begin(), c.begin() + static_cast<long>(n));
+    if (c.empty()) chunks_.pop_front();
+    cv_.notify_all();
+    return static_cast<long>(n);
+  }
+  long write(std::span<const std::uint8_t> bytes) override {
+    std::lock_guard l(m_);
+    note_thread();
+    written_.insert(written_.end(), bytes.begin(), bytes.end());
+    return static_cast<long>(bytes.size());
+  }
+  void wake() noexcept override {
+    std::lock_guard l(m_);
+    woken_ = true;
+    cv_.notify_all();
+  }
+  // Test side.
+  void give(std::vector<std::uint8_t> bytes) {
+    std::lock_guard l(m_);
+    chunks_.push_back(std::move(bytes));
+    cv_.notify_all();
+  }
+  // Waits until the reader has taken every chunk given and waits in a read again.
+  bool drained() {
+    std::unique_lock l(m_);
+    return cv_.wait_for(l, std::chrono::seconds(10), [&] { return chunks_.empty() && waiting_ > 0; });
+  }
+  bool touched_by(std::thread::id id) {
+    std::lock_guard l(m_);
+    for (auto t : threads_)
+      if (t == id) return true;
+    return false;
+  }
+  std::vector<std::uint8_t> written() {
+    std::lock_guard l(m_);
+    return written_;
+  }
+
+ private:
+  void note_thread() {
+    const auto id = std::this_thread::get_id();
+    for (auto t : threads_)
+      if (t == id) return;
+    threads_.push_back(id);
+  }
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<std::vector<std::uint8_t>> chunks_;
+  std::vector<std::uint8_t> written_;
+  std::vector<std::thread::id> threads_;
+  int waiting_ = 0;
+  
+  bool woken_ = false;
+};
+
+std::uint8_t wire_seq = 0;
+// The wire bytes of one sample frame with sample_counter k (its taxel 0 of fingertip 1 = k).
+std::vector<std::uint8_t> sample_frame(std::uint16_t k) {
+  tactile::Sample s;
+  s.sample_counter = k;
+  s.device_time_us = 4000u * k;
+  s.valid = 0x1F;
+  s.pressure_kpa[1][0] = static_cast<float>(k % 600) * 0.01f;
+  std::uint8_t payload[tactile::kSampleLen];
+  const std::size_t n = tactile::encode_sample(s, payload);
+  std::vector<std::uint8_t> wire(kSerialMaxWire);
+  wire.resize(serial_encode(wire_seq++, tactile::kTypeSample, {payload, n}, wire));
+  return wire;
+}
+
+struct Rig {
+  FakeLink* link = nullptr;
+  std::unique_ptr<TactileReader> reader;
+  Rig() {
+    auto l = std::make_unique<FakeLink>();
+    link = l.get();
+    reader = std::make_unique<TactileReader>(std::move(l), TactileHostConfig{}, "crease-t-tact");
+    reader->start();
+  }
+};
+
+// The RT side, as the driver's update calls it: no allocation allowed.
+bool take(TactileReader& r) {
+  crease::rt::ScopedRtMark rt;
+  return r.take_rt();
+}
+
+}  // namespace
+
+TEST_CASE("tactile reader: a reader blocked in its read does not hold up the RT side, which never touches the link") {
+  Rig rig;
+  REQUIRE(rig.link->drained());  // the thread is blocked in read_wait: nobody gives it bytes
+  const auto allocs = crease::rt::rt_allocation_count();
+  for (int i = 0; i < 100000; ++i) CHECK_FALSE(take(*rig.reader));  // returns every time
+  CHECK(crease::rt::rt_allocation_count() == allocs);
+  CHECK(rig.reader->samples() == 0);
+  CHECK(rig.reader->health(crease::rt::now_ns()) == LinkHealth::fault);
+  // Every read and write of the link was the reader thread's, none the RT side's.
+  CHECK_FALSE(rig.link->touched_by(std::this_thread::get_id()));
+  // The Start frame went out from the thread, at the configured rate.
+  SerialDeframer d;
+  SerialFrame f;
+  bool got = false;
+  const auto w = rig.link->written();
+  d.feed(w, f, &got);
+  REQUIRE(got);
+  std::uint16_t rate = 0;
+  CHECK(tactile::decode_start(f, rate) == Decode::ok);
+  CHECK(rate == 250);
+  CHECK(rig.reader->started());
+  // Released: a sample arrives.
+  rig.link->give(sample_frame(7));
+  REQUIRE(rig.link->drained());
+  for (int i = 0; i < 10000 && !take(*rig.reader); ++i) std::this_thread::sleep_for(std::chrono::microseconds(100));
+  CHECK(rig.reader->samples() == 1);
+  CHECK(rig.reader->sample().sample_counter == 7);
+  CHECK(rig.reader->health(rig.reader->sample_rx_ns()) == LinkHealth::ok);
+}
+
+TEST_CASE("tactile reader: every sample arrives, in order, none lost, one to four per cycle, frames split across reads") {
+  Rig rig;
+  REQUIRE(rig.link->drained());
+  std::uint16_t k = 0;
+  std::uint64_t expected = 0;
+  const auto allocs = crease::rt::rt_allocation_count();
+  for (int cycle = 0; cycle < 600; ++cycle) {
+    // 1..4 samples since the last cycle; every third cycle one of them split in two reads.
+    const int n = 1 + cycle % 4;
+    std::vector<std::uint8_t> bytes;
+    for (int i = 0; i < n; ++i) {
+      const auto f = sample_frame(k++);
+      bytes.insert(bytes.end(), f.begin(), f.end());
+    }
+    if (cycle % 3 == 0) {
+      const auto half = static_cast<long>(bytes.size() / 2 + 3);
+      rig.link->give({bytes.begin(), bytes.begin() + half});
+      rig.link->give({bytes.begin() + half, bytes.end()});
+    } else {
+      rig.link->give(bytes);
+    }
+    REQUIRE(rig.link->drained());  // the thread has queued them (it pushes before it reads again)
+    const std::uint64_t before = rig.reader->samples();
+    CHECK(take(*rig.reader));
+    expected += static_cast<std::uint64_t>(n);
+    CHECK(rig.reader->samples() - before == static_cast<std::uint64_t>(n));  // all of them this cycle
+    CHECK(rig.reader->sample().sample_counter == static_cast<std::uint16_t>(k - 1));  // the newest
+    CHECK(rig.reader->sample().pressure_kpa[1][0] == doctest::Approx(static_cast<double>((k - 1) % 600) * 0.01).epsilon(1e-4));
+    CHECK_FALSE(take(*rig.reader));  // nothing twice
+  }
+  CHECK(crease::rt::rt_allocation_count() == allocs);
+  const TactileCounters c = rig.reader->counters();
+  CHECK(c.frames == expected);
+  CHECK(c.crc_errors == 0);
+  CHECK(c.overruns == 0);
+}
+
+TEST_CASE("tactile reader: a corrupted frame is counted as a CRC error and costs only itself") {
+  Rig rig;
+  REQUIRE(rig.link->drained());
+  auto bad = sample_frame(1);
+  bad[bad.size() / 2] ^= 0x5A;
+  std::vector<std::uint8_t> bytes = sample_frame(0);
+  bytes.insert(bytes.end(), bad.begin(), bad.end());
+  const auto good = sample_frame(2);
+  bytes.insert(bytes.end(), good.begin(), good.end());
+  rig.link->give(bytes);
+  REQUIRE(rig.link->drained());
+  CHECK(take(*rig.reader));
+  CHECK(rig.reader->samples() == 2);
+  CHECK(rig.reader->sample().sample_counter == 2);
+  CHECK(rig.reader->counters().crc_errors == 1);
+}
+
+TEST_CASE("tactile reader: an RT side that stops taking for longer than the queue holds counts the dropped samples") {
+  Rig rig;
+  REQUIRE(rig.link->drained());
+  const int extra = 5;
+  for (int i = 0; i < static_cast<int>(TactileReader::kQueueCapacity) + extra; ++i) {
+    rig.link->give(sample_frame(static_cast<std::uint16_t>(i)));
+  }
+  REQUIRE(rig.link->drained());
+  CHECK(rig.reader->counters().overruns == static_cast<std::uint64_t>(extra));
+  CHECK(take(*rig.reader));
+  CHECK(rig.reader->samples() == TactileReader::kQueueCapacity);
+  CHECK(rig.reader->sample().sample_counter == TactileReader::kQueueCapacity - 1);  // the newer ones were dropped
+  rig.link->give(sample_frame(100));
+  REQUIRE(rig.link->drained());
+  CHECK(take(*rig.reader));
+  CHECK(rig.reader->sample().sample_counter == 100);  // and the stream goes on
+}
+
+TEST_CASE("tactile reader: stop wakes a blocked reader and joins it; start runs it again") {
+  Rig rig;
+  REQUIRE(rig.link->drained());
+  rig.reader->stop();  // the fake's read blocks without a timeout: only wake() ends it
+  rig.reader->start();
+  REQUIRE(rig.link->drained());
+  rig.link->give(sample_frame(3));
+  REQUIRE(rig.link->drained());
+  CHECK(take(*rig.reader));
+  CHECK(rig.reader->sample().sample_counter == 3);
+}
