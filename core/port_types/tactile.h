@@ -16,13 +16,13 @@ struct Tactile {
   static constexpr int kFingertips = 5;
   static constexpr int kTaxels = 34;
 
-  std::int64_t timestamp_ns = 0;      // CLOCK_MONOTONIC reception time of the sample
+  std::int64_t timestamp_ns = 0;      // reception time of the sample: the loop's cycle that took it
   std::uint32_t device_time_us = 0;
   std::uint16_t sample_counter = 0;
   std::uint8_t valid = 0;             // bit f: fingertip f delivered data
   std::uint8_t fresh = 0;             // 1: a new sample arrived this cycle
   DeviceHealth health = DeviceHealth::fault;
-  std::int64_t age_ns = 0;            // cycle time minus timestamp_ns (0 when not positive)
+  std::int64_t age_ns = 0;            // cycle time minus timestamp_ns
   std::uint64_t frames = 0;           // samples taken from the link so far
   std::uint64_t crc_errors = 0;       // frames the link dropped for a bad CRC or bad COBS
   std::uint64_t overruns = 0;         // samples dropped before the loop took them (its reader's queue full)

@@ -65,10 +65,11 @@ void TactileReader::run() {
   }
 }
 
-bool TactileReader::take_rt() noexcept {
+bool TactileReader::take_rt(std::int64_t now_ns) noexcept {
   bool got = false;
   while (queue_.try_pop(&held_[1 - front_])) {
     front_ = 1 - front_;
+    held_[front_].rx_ns = now_ns;
     ++taken_;
     got = true;
   }

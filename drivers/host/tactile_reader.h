@@ -8,8 +8,9 @@
 //
 // Every decoded sample goes through the queue in order; take_rt takes them all, so at the
 // sensor's rate none is lost. A queue the RT side has not emptied for kQueueCapacity samples
-// (256 ms at 250 Hz) drops the newer ones, counted as overruns. The samples are stamped with
-// CLOCK_MONOTONIC when the thread received them.
+// (256 ms at 250 Hz) drops the newer ones, counted as overruns. A sample's reception time is
+// the time of the RT side's call that took it (the loop's clock, as the rest of a cycle's
+// state), so its age and the link's health are in the loop's time.
 #pragma once
 
 #include <atomic>
@@ -48,9 +49,9 @@ class TactileReader {
   void start();
   void stop();
 
-  // RT: takes every sample the thread queued since the last call; true when one arrived. No
-  // syscall, no allocation, no lock.
-  bool take_rt() noexcept;
+  // RT: takes every sample the thread queued since the last call, received at now_ns; true
+  // when one arrived. No syscall, no allocation, no lock.
+  bool take_rt(std::int64_t now_ns) noexcept;
   [[nodiscard]] const tactile::Sample& sample() const noexcept { return held_[front_].sample; }
   [[nodiscard]] std::int64_t sample_rx_ns() const noexcept { return held_[front_].rx_ns; }
   [[nodiscard]] std::uint64_t samples() const noexcept { return taken_; }
@@ -63,7 +64,7 @@ class TactileReader {
  private:
   struct Record {
     tactile::Sample sample;
-    std::int64_t rx_ns = 0;
+    std::int64_t rx_ns = 0;  // the thread's clock in the queue; the RT side's once taken
   };
   void run();
   void send_start(std::int64_t now_ns);

@@ -101,7 +101,7 @@ class HandDriver final : public Plugin {
 
     Status status = dr::to_plugin_status(host_->health());
     if (tactile_) {
-      const bool got = tactile_->take_rt();
+      const bool got = tactile_->take_rt(now);
       const dr::tactile::Sample& s = tactile_->sample();
       tactile_out_value_.timestamp_ns = tactile_->sample_rx_ns();
       tactile_out_value_.device_time_us = s.device_time_us;
@@ -109,8 +109,7 @@ class HandDriver final : public Plugin {
       tactile_out_value_.valid = s.valid;
       tactile_out_value_.fresh = got ? 1 : 0;
       tactile_out_value_.health = dr::to_device_health(tactile_->health(now));
-      const std::int64_t age = now - tactile_out_value_.timestamp_ns;  // the thread may stamp after the cycle's time
-      tactile_out_value_.age_ns = tactile_->samples() && age > 0 ? age : 0;
+      tactile_out_value_.age_ns = tactile_->samples() ? now - tactile_out_value_.timestamp_ns : 0;
       const dr::TactileCounters c = tactile_->counters();
       tactile_out_value_.frames = tactile_->samples();
       tactile_out_value_.crc_errors = c.crc_errors;

@@ -10,29 +10,9 @@
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
 #include "rt/alloc_guard.h"
+#include "sim_cycles.h"
 
-namespace {
-// Runs `seconds` of simulated time, every loop at its rate, interleaved by deadline.
-void run_cycles(crease::PluginHost& host, double seconds, std::int64_t& now_ns, std::map<const crease::Loop*, std::uint64_t>& cycle) {
-  const std::int64_t end = now_ns + static_cast<std::int64_t>(seconds * 1e9);
-  std::map<const crease::Loop*, std::int64_t> next;
-  for (const crease::Loop* l : host.loops()) next[l] = now_ns;
-  while (true) {
-    const crease::Loop* due = nullptr;
-    for (auto& [l, t] : next) {
-      if (due == nullptr || t < next[due]) due = l;
-    }
-    if (next[due] >= end) break;
-    now_ns = next[due];
-    const crease::rt::CycleClock clock{cycle[due]++, now_ns, now_ns, due->period_ns()};
-    {
-      crease::rt::ScopedRtMark rt;  // only the cycle itself counts, not this test's bookkeeping
-      const_cast<crease::Loop*>(due)->run_cycle_rt(clock);
-    }
-    next[due] += due->period_ns();
-  }
-}
-}  // namespace
+using crease::test::run_cycles;
 
 TEST_CASE("config/sim.yaml: every plugin's steady-state cycles allocate nothing") {
   auto cfg = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/sim.yaml");

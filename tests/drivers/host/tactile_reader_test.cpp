@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "rt/alloc_guard.h"
-#include "rt/clock.h"
 
 using namespace crease::drivers;
 
@@ -117,9 +116,11 @@ struct Rig {
 };
 
 // The RT side, as the driver's update calls it: no allocation allowed.
+std::int64_t cycle_ns = 1'000'000'000;
 bool take(TactileReader& r) {
   crease::rt::ScopedRtMark rt;
-  return r.take_rt();
+  cycle_ns += 1'000'000;  // the loop's clock: 1 kHz
+  return r.take_rt(cycle_ns);
 }
 
 }  // namespace
@@ -131,7 +132,7 @@ TEST_CASE("tactile reader: a reader blocked in its read does not hold up the RT 
   for (int i = 0; i < 100000; ++i) CHECK_FALSE(take(*rig.reader));  // returns every time
   CHECK(crease::rt::rt_allocation_count() == allocs);
   CHECK(rig.reader->samples() == 0);
-  CHECK(rig.reader->health(crease::rt::now_ns()) == LinkHealth::fault);
+  CHECK(rig.reader->health(cycle_ns) == LinkHealth::fault);
   // Every read and write of the link was the reader thread's, none the RT side's.
   CHECK_FALSE(rig.link->touched_by(std::this_thread::get_id()));
   // The Start frame went out from the thread, at the configured rate.
@@ -151,7 +152,9 @@ TEST_CASE("tactile reader: a reader blocked in its read does not hold up the RT 
   for (int i = 0; i < 10000 && !take(*rig.reader); ++i) std::this_thread::sleep_for(std::chrono::microseconds(100));
   CHECK(rig.reader->samples() == 1);
   CHECK(rig.reader->sample().sample_counter == 7);
-  CHECK(rig.reader->health(rig.reader->sample_rx_ns()) == LinkHealth::ok);
+  CHECK(rig.reader->sample_rx_ns() == cycle_ns);  // received in the loop's time: the cycle that took it
+  CHECK(rig.reader->health(cycle_ns) == LinkHealth::ok);
+  CHECK(rig.reader->health(cycle_ns + 21'000'000) == LinkHealth::fault);  // nothing for 21 ms of loop time
 }
 
 TEST_CASE("tactile reader: every sample arrives, in order, none lost, one to four per cycle, frames split across reads") {
