@@ -82,6 +82,9 @@ enum class ArmMotionReason : std::uint8_t {
   tracking_lost,       // while running: the IK lost the path (a bug or a singularity)
   busy,                // a move goal while another motion is checked, runs or stops (stop it first)
   stopped,             // a stop goal
+  hand_retreat,        // the hand's controller retreats or stopped adding force (hand_control_status:
+                       // mode retreat, an inhibit, or the status stale): a running motion decelerates
+                       // and aborts, a goal is refused
   count
 };
 inline constexpr int kArmMotionReasons = static_cast<int>(ArmMotionReason::count);

@@ -41,6 +41,12 @@ bool ArmMotion::contact_fresh(const CycleInputs& in) const noexcept {
          static_cast<double>(in.now_ns - in.contact->timestamp_ns) * 1e-9 <= p_.contact_state_max_age_s;
 }
 
+bool ArmMotion::hand_retreating(const CycleInputs& in) const noexcept {
+  const HandControlStatus* h = in.hand_control;
+  return h != nullptr && (h->mode == HandMode::retreat || h->inhibit != HandInhibit::none ||
+                          static_cast<double>(in.now_ns - h->timestamp_ns) * 1e-9 > p_.hand_state_max_age_s);
+}
+
 void ArmMotion::refuse(std::uint32_t id, ArmMotionReason r) noexcept {
   ArmMotionStatus& st = s_.status;
   ++st.goals_refused;
@@ -95,6 +101,7 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   if (r == ArmMotionReason::none && g.stop_on != ArmGoal::stop_none && !contact_fresh(in)) {
     r = ArmMotionReason::no_contact_state;
   }
+  if (r == ArmMotionReason::none && hand_retreating(in)) r = ArmMotionReason::hand_retreat;
   if (r == ArmMotionReason::none && g.frame == ArmGoal::sheet && world_sheet == nullptr) r = ArmMotionReason::no_sheet;
   // The points in the world frame, metres.
   CartesianPath path;
@@ -201,7 +208,9 @@ void ArmMotion::check_path(const CycleInputs& in) noexcept {
 }
 
 void ArmMotion::run(const CycleInputs& in) noexcept {
-  if (s_.phase == ArmMotionStatus::running && s_.stop_on == ArmGoal::contact_onset) {
+  if (s_.phase == ArmMotionStatus::running && hand_retreating(in)) {
+    begin_stop(ArmMotionStatus::aborted, ArmMotionReason::hand_retreat);
+  } else if (s_.phase == ArmMotionStatus::running && s_.stop_on == ArmGoal::contact_onset) {
     if (!contact_fresh(in)) {
       begin_stop(ArmMotionStatus::aborted, ArmMotionReason::contact_stale);
     } else if (in.contact->onsets > s_.onsets_at_start && (in.contact->fingers & s_.stop_fingers) != 0) {
@@ -249,7 +258,9 @@ bool ArmMotion::step(const CycleInputs& in) noexcept {
   if (active(s_.phase) && ready != Readiness::ready) {
     finish(ArmMotionStatus::aborted, ready == Readiness::stale ? ArmMotionReason::arm_stale : ArmMotionReason::arm_fault);
   }
-  if (s_.phase == ArmMotionStatus::checking) {
+  if (s_.phase == ArmMotionStatus::checking && hand_retreating(in)) {
+    finish(ArmMotionStatus::aborted, ArmMotionReason::hand_retreat);  // nothing moved yet
+  } else if (s_.phase == ArmMotionStatus::checking) {
     check_path(in);
   } else if (s_.phase == ArmMotionStatus::running || s_.phase == ArmMotionStatus::stopping) {
     run(in);

@@ -21,7 +21,10 @@
 // Stop condition (contact_onset): checked every running cycle before the profile steps, so a
 // fired condition starts the deceleration (at the goal's stop_accel) in the same cycle; at rest
 // the state is stopped_on_contact. A stale or unhealthy contact_state while armed decelerates
-// the same way and ends aborted (contact_stale). A stale or faulted arm_state aborts at once
+// the same way and ends aborted (contact_stale). The hand's controller retreating, inhibited or
+// stale (CycleInputs::hand_control, whatever the stop condition) decelerates it the same way
+// and ends aborted (hand_retreat); a goal arriving then is refused, one being checked is
+// dropped before anything moved. A stale or faulted arm_state aborts at once
 // and holds the last command (the drive is not following: the driver commands its own safe
 // state); when the arm is ready again the held command is re-seated at the measured angles,
 // so the drive is never sent back to where it was before the fault.
@@ -38,6 +41,7 @@
 #include "core/port_types/arm_goal.h"
 #include "core/port_types/contact.h"
 #include "core/port_types/hand.h"
+#include "core/port_types/hand_control.h"
 #include "plugins/arm_motion/cartesian_path.h"
 #include "plugins/arm_motion/goal_check.h"
 #include "plugins/robot_model/arm_ik.h"
@@ -68,6 +72,10 @@ struct CycleInputs {
   const ArmState* arm = nullptr;
   const HandState* hand = nullptr;
   const ContactState* contact = nullptr;
+  // The hand's command stage (force_controller), when wired: its retreat, an inhibit, or its
+  // status older than hand_state_max_age_s stops the arm (the hand lets go: the arm must not
+  // drag on). Null: not watched.
+  const HandControlStatus* hand_control = nullptr;
 };
 
 // Everything a motion is, as plain bytes (what a hot-swap carries).
@@ -121,6 +129,7 @@ class ArmMotion {
   enum class Readiness : std::uint8_t { ready, stale, fault };
   [[nodiscard]] Readiness arm_readiness(const CycleInputs& in) const noexcept;
   [[nodiscard]] bool contact_fresh(const CycleInputs& in) const noexcept;
+  [[nodiscard]] bool hand_retreating(const CycleInputs& in) const noexcept;
   void refuse(std::uint32_t id, ArmMotionReason r) noexcept;
   void finish(ArmMotionStatus::State st, ArmMotionReason r) noexcept;
   void begin_stop(ArmMotionStatus::State end, ArmMotionReason r) noexcept;

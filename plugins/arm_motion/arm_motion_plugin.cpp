@@ -6,6 +6,8 @@
 //           hand_state    (latest HandState: the tool frame's offset at a motion's start)
 //           contact_state (latest ContactState: the stop condition)
 //           sheet_state   (latest SheetState: read only when a sheet-frame goal arrives)
+//           hand_control_status (latest HandControlStatus of the hand's force_controller:
+//                         its retreat, an inhibit or staleness stops the arm; never written: not watched)
 //   outputs arm_command   (latest ArmCommand; safe value: velocity mode, zero velocity = stay)
 //           arm_motion_status (latest ArmMotionStatus)
 // Parameters: arm_motion_params.h. The controller: arm_motion.h.
@@ -16,6 +18,7 @@
 #include "core/port_types/arm_goal.h"
 #include "core/port_types/contact.h"
 #include "core/port_types/hand.h"
+#include "core/port_types/hand_control.h"
 #include "core/port_types/sheet_state.h"
 #include "plugins/arm_motion/arm_motion.h"
 #include "plugins/arm_motion/arm_motion_params.h"
@@ -50,6 +53,7 @@ class ArmMotionPlugin final : public Plugin {
     hand_ = ports.latest_input<HandState>("hand_state");
     contact_ = ports.latest_input<ContactState>("contact_state");
     sheet_ = ports.latest_input<SheetState>("sheet_state");
+    hand_control_ = ports.latest_input<HandControlStatus>("hand_control_status");
     command_ = ports.latest_output<ArmCommand>("arm_command", safe_command());
     status_ = ports.latest_output<ArmMotionStatus>("arm_motion_status", safe_status());
   }
@@ -61,6 +65,7 @@ class ArmMotionPlugin final : public Plugin {
     in.arm = arm_.poll().has_data() ? &arm_.value() : nullptr;
     in.hand = hand_.poll().has_data() ? &hand_.value() : nullptr;
     in.contact = contact_.poll().has_data() ? &contact_.value() : nullptr;
+    in.hand_control = hand_control_.poll().has_data() ? &hand_control_.value() : nullptr;
     ArmGoal goal;
     while (goals_.try_pop(goal)) {
       const KDL::Frame* sheet = nullptr;
@@ -92,6 +97,7 @@ class ArmMotionPlugin final : public Plugin {
   LatestInput<HandState> hand_;
   LatestInput<ContactState> contact_;
   LatestInput<SheetState> sheet_;
+  LatestInput<HandControlStatus> hand_control_;
   LatestOutput<ArmCommand> command_;
   LatestOutput<ArmMotionStatus> status_;
 };

@@ -391,6 +391,69 @@ TEST_CASE("a stale contact_state while the stop condition is armed decelerates a
   }
 }
 
+// The hand's command stage lets go (force_controller retreats, or stops adding force, or its
+// status goes stale): the arm must not drag the hand on. Failing variant: the same events with
+// the status not watched (no hand_control_status port) change nothing and the motion reaches.
+TEST_CASE("the hand's controller retreating, inhibited or stale stops a running motion, decelerating, and refuses goals") {
+  enum Event { retreat, inhibit, stale };
+  for (const Event e : {retreat, inhibit, stale}) {
+    for (const bool watched : {true, false}) {
+      CAPTURE(static_cast<int>(e));
+      CAPTURE(watched);
+      Rig r;
+      r.hand_control_present = watched;
+      idle(r);
+      ArmGoal g = goal_to(ToolFrame::ff_pad, shifted(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)), 0, 0, -60), 11, 50, 500);
+      REQUIRE(r.cycle(&g));  // no stop condition: only the hand's state can stop it
+      Trace t;
+      for (int i = 0; i < 600; ++i) {
+        r.cycle();
+        t.pose.push_back(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)));
+      }
+      REQUIRE(r.motion->status().state == ArmMotionStatus::running);
+      const double v_before = t.speed_mm_s(t.pose.size() - 1);
+      if (e == retreat) r.hand_control.mode = HandMode::retreat;
+      if (e == inhibit) r.hand_control.inhibit = HandInhibit::hand_state_stale;
+      if (e == stale) r.hand_control_fresh = false;
+      // Stale: once older than hand_state_max_age_s (20 ms).
+      const int cycles = e == stale ? 21 : 1;
+      for (int i = 0; i < cycles; ++i) {
+        r.cycle();
+        t.pose.push_back(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)));
+      }
+      const std::size_t fired = t.pose.size() - 1;
+      if (!watched) {
+        CHECK(r.motion->status().state == ArmMotionStatus::running);
+        r.run_to_end();
+        CHECK(r.motion->status().state == ArmMotionStatus::reached);
+        continue;
+      }
+      CHECK(r.motion->status().state == ArmMotionStatus::stopping);
+      CHECK(t.speed_mm_s(fired) < v_before - 0.5);  // slower in the cycle it saw it
+      while (r.active()) {
+        r.cycle();
+        t.pose.push_back(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)));
+      }
+      CHECK(r.motion->status().state == ArmMotionStatus::aborted);
+      CHECK(r.motion->status().reason == static_cast<std::uint8_t>(ArmMotionReason::hand_retreat));
+      CHECK(r.motion->status().reasons[static_cast<int>(ArmMotionReason::hand_retreat)] == 1);
+      double max_decel = 0;
+      for (std::size_t i = fired; i < t.pose.size(); ++i) max_decel = std::max(max_decel, t.accel_mm_s2(i));
+      CHECK(max_decel <= 1000.0 * 1.01);  // the goal's stop deceleration, not a jump
+      // While the hand is still letting go, a new goal is refused and nothing moves.
+      const ArmCommand held = r.last;
+      ArmGoal again = goal_to(ToolFrame::ff_pad, shifted(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)), 0, 0, 10), 12, 50, 500);
+      r.cycle(&again);
+      CHECK(r.motion->status().last_refused_id == 12);
+      CHECK(r.motion->status().last_refusal == static_cast<std::uint8_t>(ArmMotionReason::hand_retreat));
+      for (int i = 0; i < 100; ++i) {
+        r.cycle();
+        REQUIRE(same_command(r.last, held));
+      }
+    }
+  }
+}
+
 TEST_CASE("a sheet-frame goal's points are taken relative to the sheet frame given at its start") {
   Rig r;
   idle(r);

@@ -16,6 +16,7 @@
 #include "core/port_types/arm_goal.h"
 #include "core/port_types/contact.h"
 #include "core/port_types/hand.h"
+#include "core/port_types/hand_control.h"
 #include "plugins/arm_motion/arm_motion.h"
 #include "plugins/robot_model/robot_model.h"
 
@@ -76,6 +77,8 @@ struct Rig {
     in.arm = &arm;
     in.hand = hand_present ? &hand_state : nullptr;
     in.contact = &contact;
+    if (hand_control_fresh) hand_control.timestamp_ns = now;
+    in.hand_control = hand_control_present ? &hand_control : nullptr;
     if (goal != nullptr) motion->on_goal(*goal, in, sheet_frame);
     const bool wrote = motion->step(in);
     if (wrote) {
@@ -117,12 +120,14 @@ struct Rig {
   ArmState arm;
   HandState hand_state;
   ContactState contact;
+  HandControlStatus hand_control;  // the hand's force_controller: holding, no inhibit
   ArmCommand last;
   std::int64_t now = 1'000'000'000;
   std::int64_t arm_stamp = 0;
   std::uint8_t drive_state = 4;
   DeviceHealth health = DeviceHealth::ok;
   bool arm_fresh = true, contact_fresh = true, follow = true, hand_present = true;
+  bool hand_control_present = true, hand_control_fresh = true;
   const KDL::Frame* sheet_frame = nullptr;
 };
 
