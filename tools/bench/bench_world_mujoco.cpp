@@ -11,6 +11,7 @@
 // centres half the sheet's thickness over the table top (the plane is lowered by the rest).
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -44,19 +45,35 @@ std::string geom_size_m(const world::Geom& g) {
   return s.str();
 }
 
-std::string scene_xml(const std::vector<MirroredShape>& shapes, double dt_s, int nodes_u, int nodes_v,
-                      double spacing_mm, double sheet_mass_kg, double table_friction, const MujocoOptions& o) {
+std::string scene_xml(const Script& scene, const std::vector<MirroredShape>& shapes, double table_friction,
+                      const MujocoOptions& o) {
+  const sheet::GridParams& g = scene.params.sheet.grid;
+  const int nodes_u = g.nodes_u, nodes_v = g.nodes_v;
+  const double spacing_mm = g.width_mm / (nodes_u - 1);
+  const double sheet_mass_kg = g.areal_density_g_per_m2 * 1e-3 * g.width_mm * g.height_mm * 1e-6;
   const double r = o.particle_radius_mm / 1000;
   const double half_thickness = o.sheet_thickness_mm / 2000;
   const double particle_mass = sheet_mass_kg / (nodes_u * nodes_v);
+  const double top = -(r - half_thickness);  // the table top (m)
+  // A finite table (the pinch's near edge) as a box, else a plane.
+  std::ostringstream table;
+  const auto& e = scene.params.table_extent_mm;
+  const double lim = 1000.0;  // mm: "no edge" becomes a 1 m margin
+  const double x0 = std::max(e[0], -lim), x1 = std::min(e[1], lim), y0 = std::max(e[2], -lim), y1 = std::min(e[3], lim);
+  const bool finite = x0 > -lim || x1 < lim || y0 > -lim || y1 < lim;
+  if (finite) {
+    table << "type='box' pos='" << (x0 + x1) / 2000 << ' ' << (y0 + y1) / 2000 << ' ' << top - 0.01 << "' size='"
+          << (x1 - x0) / 2000 << ' ' << (y1 - y0) / 2000 << " 0.01'";
+  } else {
+    table << "type='plane' pos='0 0 " << top << "' size='1 1 0.01'";
+  }
   std::ostringstream x;
   x << "<mujoco model='crease_bench_world'>\n"
-    << "  <option timestep='" << dt_s << "' gravity='0 0 -9.81' jacobian='sparse' solver='" << o.solver
+    << "  <option timestep='" << scene.params.dt_s << "' gravity='0 0 -9.81' jacobian='sparse' solver='" << o.solver
     << "' iterations='" << o.iterations << "' tolerance='" << o.tolerance << "'/>\n"
     << "  <size nconmax='" << nodes_u * nodes_v + 800 << "' njmax='" << 7 * nodes_u * nodes_v + 1500 << "'/>\n"
     << "  <worldbody>\n"
-    << "    <geom name='table' type='plane' pos='0 0 " << -(r - half_thickness) << "' size='1 1 0.01' friction='"
-    << table_friction << " 0.005 0.0001'/>\n";
+    << "    <geom name='table' " << table.str() << " friction='" << table_friction << " 0.005 0.0001'/>\n";
   for (std::size_t i = 0; i < shapes.size(); ++i) {
     const MirroredShape& s = shapes[i];
     x << "    <body name='shape" << i << "' mocap='true'><geom type='" << geom_type(s.geom.kind) << "' size='"
@@ -93,9 +110,9 @@ void sheet_nodes(const mjModel* m, const mjData* d, std::vector<sheet::Vec3>& ou
 
 }  // namespace
 
-bool run_mujoco(const std::vector<MirroredShape>& shapes, double dt_s, int nodes_u, int nodes_v, double spacing_mm,
-                double sheet_mass_kg, double table_friction, const MujocoOptions& o, SheetEnd& out) {
-  const std::string xml = scene_xml(shapes, dt_s, nodes_u, nodes_v, spacing_mm, sheet_mass_kg, table_friction, o);
+bool run_mujoco(const Script& scene, const std::vector<MirroredShape>& shapes, double table_friction,
+                const MujocoOptions& o, SheetRun& out) {
+  const std::string xml = scene_xml(scene, shapes, table_friction, o);
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   if (mj_makeEmptyFileVFS(&vfs, "scene.xml", static_cast<int>(xml.size())) != 0) return false;
@@ -119,15 +136,17 @@ bool run_mujoco(const std::vector<MirroredShape>& shapes, double dt_s, int nodes
   mj_forward(m, d);
   sheet_nodes(m, d, out.start);
 
-  std::size_t steps = shapes.empty() ? 0 : shapes.front().poses.size();
-  if (o.max_steps > 0 && o.max_steps < steps) steps = o.max_steps;
-  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t steps = shapes.empty() ? 0 : shapes.front().poses.size();
+  double wall = 0;
   for (std::size_t k = 0; k < steps; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < shapes.size(); ++i) set_mocap(m, d, static_cast<int>(i) + 1, shapes[i].poses[k]);
     mj_step(m, d);
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (k == scene.mark_step) sheet_nodes(m, d, out.mark);
   }
-  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.simulated_s = static_cast<double>(steps) * dt_s;
+  out.wall_s = wall;
+  out.simulated_s = static_cast<double>(steps) * scene.params.dt_s;
   sheet_nodes(m, d, out.end);
   out.lowest_z_mm = 1e9;
   for (const sheet::Vec3& p : out.end) out.lowest_z_mm = std::min(out.lowest_z_mm, p.z);
