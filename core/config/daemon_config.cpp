@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unordered_set>
 
 #include "core/config/yaml_reader.h"
 
@@ -55,15 +56,11 @@ std::string resolve(const std::string& file, const std::string& p) {
 void check_no_duplicate_keys(const std::string& file, const YAML::Node& node,
                              const std::string& path) {
   if (node.IsMap()) {
-    std::vector<std::string> seen;
+    std::unordered_set<std::string> seen;  // a flat map of many keys stays linear
     for (auto it = node.begin(); it != node.end(); ++it) {
       const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string("?");
-      if (it->first.IsScalar()) {
-        if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
-          throw ConfigError(loc_of(file, it->first), path + "." + key,
-                            "duplicate key '" + key + "'");
-        }
-        seen.push_back(key);
+      if (it->first.IsScalar() && !seen.insert(key).second) {
+        throw ConfigError(loc_of(file, it->first), path + "." + key, "duplicate key '" + key + "'");
       }
       check_no_duplicate_keys(file, it->second, path + "." + key);
     }
@@ -330,13 +327,7 @@ std::vector<const PluginConfig*> DaemonConfig::plugins_of_loop(const std::string
 DaemonConfig load_daemon_config_from_string(const std::string& text,
                                             const std::string& virtual_file,
                                             const LoadOptions& options) {
-  YAML::Node doc;
-  try {
-    doc = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(SourceLoc{virtual_file, e.mark.line + 1, e.mark.column + 1}, "(syntax)",
-                      e.msg);
-  }
+  const YAML::Node doc = load_bounded_yaml(text, virtual_file, options.bounds);
   if (!doc.IsMap()) {
     SourceLoc loc = loc_of(virtual_file, doc);
     if (loc.line == 0) loc = SourceLoc{virtual_file, 1, 1};
@@ -359,9 +350,12 @@ DaemonConfig load_daemon_config(const std::string& path, const LoadOptions& opti
   if (!in) {
     throw ConfigError(SourceLoc{path, 0, 0}, "(file)", "cannot read the configuration file");
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_daemon_config_from_string(text.str(), path, options);
+  // One byte past the limit is enough to refuse it, however large (or endless) the file is.
+  std::string text(options.bounds.max_bytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) throw ConfigError(SourceLoc{path, 0, 0}, "(file)", "cannot read the configuration file");
+  return load_daemon_config_from_string(text, path, options);
 }
 
 const char* to_string(OverrunPolicy p) noexcept {

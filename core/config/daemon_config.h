@@ -17,6 +17,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/config/yaml_bounds.h"
 #include "core/errors.h"
 
 namespace crease::config {
@@ -99,9 +100,13 @@ struct DaemonConfig {
 struct LoadOptions {
   // Refuse plugin_dirs that do not exist or are not directories.
   bool check_plugin_dirs_exist = true;
+  // The file's size and node count (aliases expanded): past them, a ConfigError at the byte
+  // or node where the limit is crossed, before any walk of the tree (yaml_bounds.h).
+  YamlBounds bounds{};
 };
 
-// Loads FILE; relative paths resolve against FILE's folder.
+// Loads FILE; relative paths resolve against FILE's folder. Reads at most
+// options.bounds.max_bytes + 1 bytes of it (a FIFO or /dev/zero too).
 // @throws ConfigError (also for an unreadable file: "FILE:0:0: (file): cannot read: ...").
 [[nodiscard]] DaemonConfig load_daemon_config(const std::string& path,
                                               const LoadOptions& options = {});

@@ -301,3 +301,53 @@ TEST_CASE("--set INSTANCE.KEY=VALUE overrides one plugin parameter; a bad assign
     }
   }
 }
+
+TEST_CASE("bounded: an alias bomb in params and a 50 MB file are refused at where the limit is crossed") {
+  // 10^10 leaves inside a plugin's params; every walk of them (the duplicate-key check, the
+  // plugin's) would take hours. Refused at the alias on line 16 (l4) where 100,000 nodes are passed.
+  std::string bomb = HEAD "plugins:\n  - name: a\n    library: x\n    loop: control\n    order: 1\n"
+                          "    params:\n      l0: &l0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int k = 1; k < 10; ++k) {
+    const std::string prev = "*l" + std::to_string(k - 1);
+    bomb += "      l" + std::to_string(k) + ": &l" + std::to_string(k) + " [" + prev;
+    for (int i = 1; i < 10; ++i) bomb += ", " + prev;
+    bomb += "]\n";
+  }
+  const std::string e = error_of(bomb);
+  CAPTURE(e);
+  CHECK(e.find("/etc/crease/bad.yaml:16:") == 0);
+  CHECK(e.find(": plugins[0].params.l4[") != std::string::npos);
+  CHECK(e.find("more than 100000 nodes with aliases expanded") != std::string::npos);
+
+  // A 50 MB file (a valid configuration, then comments): refused after reading 1 MiB + 1 byte.
+  const std::string dir = std::filesystem::temp_directory_path() / ("crease_cfg_big_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/big.yaml";
+  {
+    std::ofstream out(file);
+    out << "plugin_dirs: [.]\nloops: [{name: a, rate_hz: 1, priority: 0}]\n";
+    const std::string comment = "# " + std::string(98, 'c') + "\n";  // 101 bytes a line
+    for (int i = 0; i < 500'000; ++i) out << comment;
+  }
+  REQUIRE(std::filesystem::file_size(file) > 50'000'000);
+  try {
+    (void)cfg::load_daemon_config(file);
+    FAIL("expected a ConfigError");
+  } catch (const cfg::ConfigError& ce) {
+    // Byte 1048577: after the two lines of 17 and 45 bytes and 10381 lines of comment, the
+    // 35th byte of the next one.
+    CHECK(std::string(ce.what()) == file + ":10384:35: (file): larger than 1048576 bytes (the limit of a configuration file)");
+  }
+  // A file without an end is refused the same way.
+  try {
+    (void)cfg::load_daemon_config("/dev/zero");
+    FAIL("expected a ConfigError");
+  } catch (const cfg::ConfigError& ce) {
+    CHECK(std::string(ce.what()).find("/dev/zero:1:1048577: (file): larger than") == 0);
+  }
+  // The bounds are options: the same file loads with a larger size limit.
+  cfg::LoadOptions roomy{false};
+  roomy.bounds.max_bytes = 64u << 20;
+  CHECK(cfg::load_daemon_config(file, roomy).loops.at(0).name == "a");
+  std::filesystem::remove_all(dir);
+}
