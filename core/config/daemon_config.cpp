@@ -94,7 +94,7 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
   if (!root.has("daemon")) return;
   const MapReader m(root.file(), root.get("daemon"), "daemon",
                     {"socket", "socket_group", "report_dir", "duration_s", "lock_memory",
-                     "prefault_heap_mb", "cpu_dma_latency_us", "non_rt_cpus"});
+                     "prefault_heap_mb", "cpu_dma_latency_us", "non_rt_cpus", "control"});
   const std::string& f = m.file();
   DaemonSettings& d = cfg.daemon;
   d.loc = m.loc();
@@ -133,6 +133,20 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
       cpus.push_back(static_cast<int>(read_int(f, list[i], path + "[" + std::to_string(i) + "]", 0, 1023)));
     }
     d.non_rt_cpus = cpus;
+  }
+  if (m.has("control")) {
+    const MapReader c(f, m.get("control"), m.path_of("control"), {"idle_timeout_s", "max_requests_per_s", "max_clients"});
+    d.control.loc = c.loc();
+    if (c.has("idle_timeout_s")) {
+      d.control.idle_timeout_s = read_number(f, c.get("idle_timeout_s"), c.path_of("idle_timeout_s"), 0.0, 86400.0, false);
+    }
+    if (c.has("max_requests_per_s")) {
+      d.control.max_requests_per_s =
+          read_number(f, c.get("max_requests_per_s"), c.path_of("max_requests_per_s"), 0.0, 1e6, false);
+    }
+    if (c.has("max_clients")) {
+      d.control.max_clients = static_cast<int>(read_int(f, c.get("max_clients"), c.path_of("max_clients"), 1, 4096));
+    }
   }
 }
 

@@ -32,6 +32,14 @@ using crease::SourceLoc;
 [[nodiscard]] ConfigError error_at(const std::string& file, const YAML::Node& node,
                                    const std::string& key_path, const std::string& reason);
 
+// daemon.control: the control socket's limits per client (core/control/control_server.h).
+struct ControlSettings {
+  double idle_timeout_s = 30;        // a silent client is closed after this; 0 = never
+  double max_requests_per_s = 500;   // beyond it a client's requests are answered `busy`; 0 = no limit
+  int max_clients = 128;             // connections at once (the idlest yields to a new one)
+  SourceLoc loc;
+};
+
 struct DaemonSettings {
   std::optional<std::string> socket;        // control socket path; absent: creased's default
   std::optional<std::string> socket_group;  // group allowed on the socket (0660)
@@ -45,6 +53,7 @@ struct DaemonSettings {
   // pinned to is shared with that loop (creased says so at start): e.g. a simulated world's.
   std::optional<std::vector<int>> non_rt_cpus;
   SourceLoc non_rt_cpus_loc;
+  ControlSettings control;
   SourceLoc loc;
 };
 

@@ -1,7 +1,9 @@
 #include "core/control/control_server.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstdio>
 #include <deque>
 #include <set>
 #include <thread>
@@ -12,6 +14,7 @@
 #include <unistd.h>
 
 #include "core/control/protocol.h"
+#include "core/control/request_parser.h"
 #include "core/control/socket_file.h"
 #include "rt/thread_placement.h"
 
@@ -26,8 +29,8 @@ struct AtomicCounters {
   std::atomic<std::uint64_t> connections_accepted{0}, clients_active{0},
       rejected_too_many_clients{0}, rejected_peer_credentials{0}, requests{0}, replies_ok{0},
       malformed{0}, unknown_command{0}, bad_argument{0}, failed{0}, internal_errors{0},
-      line_too_long{0}, partial_line_timeouts{0}, idle_timeouts{0}, slow_reader_disconnects{0},
-      bytes_in{0}, bytes_out{0};
+      line_too_long{0}, partial_line_timeouts{0}, idle_timeouts{0}, idle_evictions{0},
+      slow_reader_disconnects{0}, busy{0}, bytes_in{0}, bytes_out{0};
 };
 
 void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) {
@@ -64,6 +67,8 @@ struct ControlServer::Impl {
   Impl(ServerOptions o, RequestHandler& h) : opt(std::move(o)), handler(h) {}
   void do_accept();
   bool peer_allowed(Local::socket& s) const;
+  // Closes the session idle the longest to make room; false when none is idle.
+  bool evict_oldest_idle();
 };
 
 struct Session : std::enable_shared_from_this<Session> {
@@ -77,11 +82,32 @@ struct Session : std::enable_shared_from_this<Session> {
   std::size_t out_bytes = 0;
   std::uint64_t timer_gen = 0;
   bool reading = false, writing = false, busy = false, closing = false, closed = false;
+  std::chrono::steady_clock::time_point last_active = std::chrono::steady_clock::now();
+  // Token bucket of the request rate: opt.max_requests_per_s tokens a second, as many at most.
+  double tokens = 0;
+  std::chrono::steady_clock::time_point refilled = last_active;
 
   Session(ControlServer::Impl& s, Local::socket&& so)
-      : srv(s), sock(std::move(so)), timer(s.io) {}
+      : srv(s), sock(std::move(so)), timer(s.io), tokens(std::max(s.opt.max_requests_per_s, 1.0)) {}
 
   void start() { pump(); }
+
+  // Waiting for a request with nothing half-read, queued, in the handler or unsent.
+  [[nodiscard]] bool idle() const {
+    return reading && !closing && !closed && !busy && inbuf.empty() && pending.empty() && outq.empty();
+  }
+
+  // Takes one token; false when the client is over its rate (0 = no limit).
+  bool take_token() {
+    const double rate = srv.opt.max_requests_per_s;
+    if (rate <= 0) return true;
+    const auto now = std::chrono::steady_clock::now();
+    tokens = std::min(std::max(rate, 1.0), tokens + rate * std::chrono::duration<double>(now - refilled).count());
+    refilled = now;
+    if (tokens < 1.0) return false;
+    tokens -= 1.0;
+    return true;
+  }
 
   void arm_timer() {
     const bool partial = !inbuf.empty();
@@ -114,6 +140,7 @@ struct Session : std::enable_shared_from_this<Session> {
         return;
       }
       bump(self->srv.c.bytes_in, n);
+      self->last_active = std::chrono::steady_clock::now();
       self->on_data(n);
     });
   }
@@ -149,27 +176,24 @@ struct Session : std::enable_shared_from_this<Session> {
       const std::string line = std::move(pending.front());
       pending.pop_front();
       bump(srv.c.requests);
-      nlohmann::json req = nlohmann::json::parse(line, nullptr, false);
-      if (req.is_discarded() || !req.is_object()) {
-        bump(srv.c.malformed);
-        send(make_error(nullptr, kErrorMalformed, "request is not a JSON object"));
+      ParsedRequest parsed = parse_request(line);
+      if (!take_token()) {
+        bump(srv.c.busy);
+        char why[96];
+        std::snprintf(why, sizeof(why), "over this client's limit of %g requests per second; not handled",
+                      srv.opt.max_requests_per_s);
+        send(make_error(parsed.id, kErrorBusy, why));
         continue;
       }
-      const nlohmann::json id = req.contains("id") ? req["id"] : nlohmann::json(nullptr);
-      const auto cmd = req.find("cmd");
-      if (cmd == req.end() || !cmd->is_string()) {
-        bump(srv.c.malformed);
-        send(make_error(id, kErrorMalformed, "request has no string 'cmd'"));
-        continue;
-      }
-      if (!is_known_command(cmd->get_ref<const std::string&>())) {
-        bump(srv.c.unknown_command);
-        send(make_error(id, kErrorUnknownCommand,
-                        "unknown command '" + cmd->get<std::string>() + "'"));
+      if (!parsed.ok()) {
+        bump(parsed.error_code == kErrorMalformed     ? srv.c.malformed
+             : parsed.error_code == kErrorBadArgument ? srv.c.bad_argument
+                                                      : srv.c.unknown_command);
+        send(make_error(parsed.id, parsed.error_code, parsed.error_message));
         continue;
       }
       busy = true;
-      asio::post(srv.work, [self = shared_from_this(), req = std::move(req), id]() {
+      asio::post(srv.work, [self = shared_from_this(), req = std::move(parsed.request), id = parsed.id]() {
         nlohmann::json reply = self->call_handler(req, id);
         asio::post(self->srv.io, [self, reply = std::move(reply)]() {
           self->busy = false;
@@ -189,7 +213,7 @@ struct Session : std::enable_shared_from_this<Session> {
       return make_ok(id, std::move(result));
     } catch (const RequestError& e) {
       bump(e.code() == kErrorBadArgument ? srv.c.bad_argument : srv.c.failed);
-      return make_error(id, e.code(), e.what());
+      return make_error(id, e.code(), e.message());
     } catch (const std::exception& e) {
       bump(srv.c.internal_errors);
       return make_error(id, kErrorInternal, e.what());
@@ -223,6 +247,7 @@ struct Session : std::enable_shared_from_this<Session> {
                           return;
                         }
                         bump(self->srv.c.bytes_out, n);
+                        self->last_active = std::chrono::steady_clock::now();
                         self->out_bytes -= self->outq.front().size();
                         self->outq.pop_front();
                         if (!self->outq.empty()) {
@@ -277,6 +302,17 @@ bool ControlServer::Impl::peer_allowed(Local::socket& s) const {
   return group_gid.has_value() && cred.gid == *group_gid;
 }
 
+bool ControlServer::Impl::evict_oldest_idle() {
+  std::shared_ptr<Session> oldest;
+  for (const auto& s : sessions) {
+    if (s->idle() && (!oldest || s->last_active < oldest->last_active)) oldest = s;
+  }
+  if (!oldest) return false;
+  bump(c.idle_evictions);
+  oldest->close();
+  return true;
+}
+
 void ControlServer::Impl::do_accept() {
   acceptor.async_accept([this](boost::system::error_code ec, Local::socket s) {
     if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
@@ -293,7 +329,7 @@ void ControlServer::Impl::do_accept() {
         bump(c.rejected_peer_credentials);
         send_and_close(s, to_line(make_error(nullptr, kErrorPermissionDenied,
                                              "peer uid is not allowed on this socket")));
-      } else if (sessions.size() >= opt.max_clients) {
+      } else if (sessions.size() >= opt.max_clients && !evict_oldest_idle()) {
         bump(c.rejected_too_many_clients);
         send_and_close(s, to_line(make_error(nullptr, kErrorTooManyClients,
                                              "too many clients (" +
@@ -402,7 +438,9 @@ ServerCounters ControlServer::counters() const {
   s.line_too_long = a.line_too_long.load();
   s.partial_line_timeouts = a.partial_line_timeouts.load();
   s.idle_timeouts = a.idle_timeouts.load();
+  s.idle_evictions = a.idle_evictions.load();
   s.slow_reader_disconnects = a.slow_reader_disconnects.load();
+  s.busy = a.busy.load();
   s.bytes_in = a.bytes_in.load();
   s.bytes_out = a.bytes_out.load();
   return s;
@@ -425,7 +463,9 @@ nlohmann::json ServerCounters::to_json() const {
                         {"line_too_long", line_too_long},
                         {"partial_line_timeouts", partial_line_timeouts},
                         {"idle_timeouts", idle_timeouts},
+                        {"idle_evictions", idle_evictions},
                         {"slow_reader_disconnects", slow_reader_disconnects},
+                        {"busy", busy},
                         {"bytes_in", bytes_in},
                         {"bytes_out", bytes_out}};
 }

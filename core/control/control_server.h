@@ -16,12 +16,16 @@
 // becomes an "internal" error. Requests whose "cmd" is not in known_commands() are answered
 // "unknown_command" without calling the handler.
 //
+// Requests are checked by parse_request (request_parser.h) before any handler sees them.
 // Misbehaving clients get an error reply and/or a disconnect, and are counted (counters()):
-// malformed JSON (reply, stay connected), unknown commands (reply), bad arguments (reply),
-// a line longer than max_line_bytes (reply, disconnect), a half-sent line older than
-// partial_line_timeout (reply, disconnect), a reader whose queued replies exceed
-// max_output_bytes (disconnect), more than max_clients at once (reply, disconnect), a peer
-// whose SO_PEERCRED uid is not allowed (reply, disconnect).
+// malformed JSON or a key twice (reply, stay connected), unknown commands (reply), bad
+// arguments (reply), requests over max_requests_per_s (a `busy` reply, not handled), a line
+// longer than max_line_bytes (reply, disconnect), a half-sent line older than
+// partial_line_timeout (reply, disconnect), a client silent for idle_timeout (disconnect), a
+// reader whose queued replies exceed max_output_bytes (disconnect), a peer whose SO_PEERCRED
+// uid is not allowed (reply, disconnect). A new client finding max_clients connected takes
+// the place of the one idle the longest (closed, counted); only when none is idle (each is
+// mid-request) is it refused (reply, disconnect): silent clients keep no one out.
 #pragma once
 
 #include <chrono>
@@ -58,7 +62,10 @@ struct ServerOptions {
   std::size_t max_output_bytes = 1 << 20;  // queued reply bytes per client before disconnect
   std::size_t max_clients = 128;
   std::chrono::milliseconds partial_line_timeout{5000};  // half-sent line -> disconnect
-  std::chrono::milliseconds idle_timeout{0};             // silent client; 0 = never
+  std::chrono::milliseconds idle_timeout{30000};         // silent client -> closed; 0 = never
+  // Requests a second per client (a token bucket of as many, at least 1): beyond it each
+  // request is answered `busy` unhandled. 0 = no limit.
+  double max_requests_per_s = 500;
   std::chrono::milliseconds stop_flush_timeout{500};     // stop(): time to flush replies
   // Peers allowed besides this process's euid and root (e.g. for tests); the group's gid
   // is also allowed when socket_group is set.
@@ -73,15 +80,17 @@ struct ServerCounters {
   std::uint64_t rejected_peer_credentials = 0;
   std::uint64_t requests = 0;         // complete lines that reached dispatch
   std::uint64_t replies_ok = 0;
-  std::uint64_t malformed = 0;        // not JSON, not an object, no string "cmd"
+  std::uint64_t malformed = 0;        // not JSON, a key twice, not an object, no string "cmd"
   std::uint64_t unknown_command = 0;
-  std::uint64_t bad_argument = 0;     // handler threw RequestError(kErrorBadArgument)
+  std::uint64_t bad_argument = 0;     // an argument outside the spec or mistyped; or the handler's
   std::uint64_t failed = 0;           // handler threw RequestError with another code
   std::uint64_t internal_errors = 0;  // handler threw something else
   std::uint64_t line_too_long = 0;
   std::uint64_t partial_line_timeouts = 0;
   std::uint64_t idle_timeouts = 0;
+  std::uint64_t idle_evictions = 0;   // idle clients closed to let a new one in
   std::uint64_t slow_reader_disconnects = 0;
+  std::uint64_t busy = 0;             // requests over the client's rate, answered `busy`
   std::uint64_t bytes_in = 0;
   std::uint64_t bytes_out = 0;
 

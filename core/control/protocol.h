@@ -4,15 +4,17 @@
 //   reply:   {"id": ..., "ok": true,  "result": <any>}
 //            {"id": ..., "ok": false, "error": {"code": "...", "message": "..."}}
 //
-// Commands (the daemon implements them; ControlServer frames and dispatches):
-//   status, loops, plugins, ports, stats, stop                     (no arguments)
-//   load        instance, library, loop, order
+// Commands (the daemon implements them; ControlServer frames, checks and dispatches):
+//   status, loops, plugins, ports, stats, stop, threads            (no arguments)
+//   load        instance, library, loop, order, [params (object), ports (object of strings)]
 //   unload      instance
-//   swap        instance, library
+//   swap        instance, library, [params (object)]
 //   activate    instance
 //   deactivate  instance
-//   param       action ("get" | "set"), instance, key, [value (set)]
+//   param       action ("get" | "set"), instance, key, [value (a JSON number, set)]
 //   report      format ("html" | "json" | "text")  -> result {"format":..., "content": "..."}
+// Every request is checked against command_specs() before a handler sees it
+// (request_parser.h): no argument outside the command's list, each of its JSON type.
 // Error codes: see the kError* constants.
 #pragma once
 
@@ -26,7 +28,7 @@
 
 namespace crease::control {
 
-inline constexpr char kErrorMalformed[] = "malformed";           // not JSON / not an object
+inline constexpr char kErrorMalformed[] = "malformed";  // not JSON, not an object, a key twice
 inline constexpr char kErrorUnknownCommand[] = "unknown_command";
 inline constexpr char kErrorBadArgument[] = "bad_argument";      // missing / mistyped argument
 inline constexpr char kErrorLineTooLong[] = "line_too_long";     // then disconnected
@@ -35,20 +37,47 @@ inline constexpr char kErrorTooManyClients[] = "too_many_clients";
 inline constexpr char kErrorPermissionDenied[] = "permission_denied";
 inline constexpr char kErrorFailed[] = "failed";                 // the command itself failed
 inline constexpr char kErrorInternal[] = "internal";             // handler threw unexpectedly
+inline constexpr char kErrorBusy[] = "busy";  // over the client's request rate; not handled
 
-// Every command the protocol defines, in documentation order.
+// The JSON type an argument must have: string (non-empty, no NUL), integer (a JSON integer),
+// number (a finite JSON number; never a string), object, string_map (an object of strings).
+enum class ArgType { string, integer, number, object, string_map };
+struct ArgSpec {
+  const char* name;
+  ArgType type;
+};
+// A command and every argument it may take besides "id" and "cmd" (which are required is
+// the handler's to say).
+struct CommandSpec {
+  std::string_view name;
+  std::vector<ArgSpec> args;
+};
+
+// Every command the protocol defines: the one list (a new command is a row here).
+[[nodiscard]] const std::vector<CommandSpec>& command_specs();
+// The spec of CMD, or nullptr.
+[[nodiscard]] const CommandSpec* find_command_spec(std::string_view cmd);
+[[nodiscard]] const char* to_string(ArgType t) noexcept;
+
+// Every command the protocol defines, in documentation order (command_specs()' names).
 [[nodiscard]] const std::vector<std::string>& known_commands();
 [[nodiscard]] bool is_known_command(std::string_view cmd);
 
-// Thrown by a RequestHandler to reply {"ok": false, "error": {code, message}}.
+// TEXT quoted for a message: control characters (NUL included) as \u00XX, the rest as is.
+[[nodiscard]] std::string printable(std::string_view text);
+
+// Thrown by a RequestHandler to reply {"ok": false, "error": {code, message}}. The reply
+// carries message(), the whole string (what() stops at a NUL).
 class RequestError : public std::runtime_error {
  public:
   RequestError(std::string code, const std::string& message)
-      : std::runtime_error(message), code_(std::move(code)) {}
+      : std::runtime_error(message), code_(std::move(code)), message_(message) {}
   [[nodiscard]] const std::string& code() const noexcept { return code_; }
+  [[nodiscard]] const std::string& message() const noexcept { return message_; }
 
  private:
   std::string code_;
+  std::string message_;
 };
 
 // Argument accessors for handlers: throw RequestError(kErrorBadArgument, ...) naming the

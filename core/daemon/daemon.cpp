@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -117,6 +118,9 @@ int Daemon::run() {
   control::ServerOptions so;
   so.socket_path = options_.socket ? *options_.socket : d.socket ? *d.socket : control::default_socket_path();
   so.socket_group = d.socket_group;
+  so.idle_timeout = std::chrono::milliseconds(std::llround(d.control.idle_timeout_s * 1e3));
+  so.max_requests_per_s = d.control.max_requests_per_s;
+  so.max_clients = static_cast<std::size_t>(d.control.max_clients);
   server_ = std::make_unique<control::ControlServer>(so, *this);
   server_->start();  // before the loops: its threads' creation is done when they take deadlines
 

@@ -6,8 +6,9 @@ namespace {
 double us(std::uint64_t ns) { return double(ns) / 1000.0; }
 }  // namespace
 
-nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns) {
-  return {{"state", "running"},
+nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns,
+                           const control::ControlServer* server) {
+  nlohmann::json s = {{"state", "running"},
           {"config", facts.config_file},
           {"uptime_s", double(now_ns - facts.start_ns) * 1e-9},
           {"loops", host.loops().size()},
@@ -15,6 +16,13 @@ nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::i
           {"faults", host.fault_count()},
           {"sched_fifo", facts.sched_fifo_applied},
           {"mlockall", facts.mlockall_applied}};
+  if (server != nullptr) {
+    const control::ServerCounters c = server->counters();
+    s["control"] = {{"clients", c.clients_active},
+                    {"busy", c.busy},
+                    {"refused", c.malformed + c.unknown_command + c.bad_argument}};
+  }
+  return s;
 }
 
 nlohmann::json loops_view(const PluginHost& host) {

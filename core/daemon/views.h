@@ -14,9 +14,12 @@
 
 namespace crease::daemon {
 
-// State, configuration, uptime since facts.start_ns (now_ns: CLOCK_MONOTONIC), counts, and
-// whether SCHED_FIFO and mlockall were applied.
-[[nodiscard]] nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns);
+// State, configuration, uptime since facts.start_ns (now_ns: CLOCK_MONOTONIC), counts,
+// whether SCHED_FIFO and mlockall were applied, and with a SERVER its clients and the
+// requests it refused: {"control": {"clients", "busy", "refused"}} (refused: malformed,
+// unknown, bad arguments).
+[[nodiscard]] nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::int64_t now_ns,
+                                         const control::ControlServer* server = nullptr);
 // Per loop: spec, cycles, overruns, wake-up and execution percentiles (us).
 [[nodiscard]] nlohmann::json loops_view(const PluginHost& host);
 // Where the non-RT threads run (daemon.non_rt_cpus), and every thread of the daemon now: name,

@@ -152,7 +152,13 @@ int main(int argc, char** argv) {
   auto* pset = param->add_subcommand("set", "change a parameter (validated by the plugin)");
   pset->add_option("INSTANCE", o.instance, "instance name")->required();
   pset->add_option("KEY", o.key, "parameter name")->required();
-  pset->add_option("VALUE", o.value, "new value (JSON, or plain text for a string)")->required();
+  pset->add_option("VALUE", o.value, "new value, a number (sent as a JSON number)")
+      ->required()
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            return crease::ctl::parse_cli_value(v).is_number() ? std::string() : "not a number: '" + v + "'";
+          },
+          "NUMBER"));
   pset->callback([&] {
     cmd = "param";
     request = {{"cmd", "param"}, {"action", "set"}, {"instance", o.instance}, {"key", o.key},

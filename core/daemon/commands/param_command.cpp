@@ -1,5 +1,6 @@
 // param {action: get | set, instance, key, value (set)}: a tunable parameter, read or set; a
 // set value applies at the next cycle boundary after the plugin validated it.
+#include <cmath>
 #include <optional>
 
 #include "core/control/protocol.h"
@@ -8,20 +9,11 @@
 namespace crease::daemon {
 namespace {
 
-// A JSON number, or a string holding one number and nothing else (what the command line
-// sends), else nullopt.
+// A finite JSON number, else nullopt: a string is never read as one ("0x10", "1e999").
 std::optional<double> number_of(const nlohmann::json& value) {
-  if (value.is_number()) return value.get<double>();
-  if (!value.is_string()) return std::nullopt;
-  const std::string& s = value.get_ref<const std::string&>();
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(s, &used);
-    if (used != s.size()) return std::nullopt;
-    return v;
-  } catch (const std::logic_error&) {  // std::stod: not a number, or out of range
-    return std::nullopt;
-  }
+  if (!value.is_number()) return std::nullopt;
+  const double v = value.get<double>();
+  return std::isfinite(v) ? std::optional<double>(v) : std::nullopt;
 }
 
 }  // namespace
@@ -45,7 +37,8 @@ nlohmann::json param_command(const nlohmann::json& req, CommandContext& ctx) {
     if (!why.empty()) throw control::RequestError(control::kErrorFailed, why);
     return {{"instance", instance}, {"key", key}, {"value", *v}, {"applies", "at the next cycle boundary"}};
   }
-  throw control::RequestError(control::kErrorBadArgument, "param: action must be get or set, not '" + action + "'");
+  throw control::RequestError(control::kErrorBadArgument,
+                              "param: action must be get or set, not '" + control::printable(action) + "'");
 }
 
 }  // namespace crease::daemon

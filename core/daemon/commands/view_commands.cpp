@@ -6,7 +6,7 @@
 namespace crease::daemon {
 
 nlohmann::json status_command(const nlohmann::json&, CommandContext& ctx) {
-  return status_view(ctx.host, ctx.facts, rt::now_ns());
+  return status_view(ctx.host, ctx.facts, rt::now_ns(), ctx.server);
 }
 
 nlohmann::json loops_command(const nlohmann::json&, CommandContext& ctx) { return loops_view(ctx.host); }

@@ -351,3 +351,23 @@ TEST_CASE("bounded: an alias bomb in params and a 50 MB file are refused at wher
   CHECK(cfg::load_daemon_config(file, roomy).loops.at(0).name == "a");
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("daemon.control: the control socket's limits per client, defaults on") {
+  const auto d = cfg::load_daemon_config_from_string(HEAD, "c.yaml", kNoDirCheck).daemon.control;
+  CHECK(d.idle_timeout_s == doctest::Approx(30.0));
+  CHECK(d.max_requests_per_s == doctest::Approx(500.0));
+  CHECK(d.max_clients == 128);
+  const auto c = cfg::load_daemon_config_from_string(
+                     HEAD "daemon: {control: {idle_timeout_s: 0.5, max_requests_per_s: 0, max_clients: 4}}\n", "c.yaml",
+                     kNoDirCheck)
+                     .daemon.control;
+  CHECK(c.idle_timeout_s == doctest::Approx(0.5));
+  CHECK(c.max_requests_per_s == 0.0);
+  CHECK(c.max_clients == 4);
+  CHECK(error_of(HEAD "daemon: {control: {idle_timeout_s: -1}}\n") ==
+        "/etc/crease/bad.yaml:6:36: daemon.control.idle_timeout_s: must be in [0, 86400], got -1");
+  CHECK(error_of(HEAD "daemon: {control: {max_clients: 0}}\n").find("daemon.control.max_clients: must be in [1, 4096]") !=
+        std::string::npos);
+  CHECK(error_of(HEAD "daemon: {control: {rate: 5}}\n").find("daemon.control.rate: unknown key 'rate'") !=
+        std::string::npos);
+}

@@ -30,13 +30,17 @@ using namespace std::chrono_literals;
 namespace {
 
 // Echoes its arguments; 'param' needs instance/key; 'stop' throws a plain exception;
-// 'ports' returns BIG bytes of payload (slow-reader test).
+// 'ports' returns BIG bytes of payload (slow-reader test); 'activate' fails with a NUL in its
+// message; every 'stop' that reaches it is counted.
 struct TestHandler : ctl::RequestHandler {
   std::atomic<int> calls{0};
+  std::atomic<int> stops{0};
   std::size_t big = 4096;
   json handle(const json& request) override {
     ++calls;
     const std::string cmd = request.at("cmd");
+    if (cmd == "activate") throw ctl::RequestError(ctl::kErrorFailed, std::string("before\0after", 12));
+    if (cmd == "stop") ++stops;
     if (cmd == "status") return json{{"state", "running"}, {"echo", request}};
     if (cmd == "param") {
       return json{{"instance", ctl::require_string(request, "instance")},
@@ -150,11 +154,11 @@ TEST_CASE("replies, error objects and counters for malformed and bad requests") 
   server.start();
   ctl::ControlClient c(server.socket_path());
 
-  json r = c.request({{"id", "abc"}, {"cmd", "status"}, {"extra", 7}});
+  json r = c.request({{"id", "abc"}, {"cmd", "status"}});
   CHECK(r["id"] == "abc");
   CHECK(r["ok"] == true);
   CHECK(r["result"]["state"] == "running");
-  CHECK(r["result"]["echo"]["extra"] == 7);
+  CHECK(r["result"]["echo"]["cmd"] == "status");
 
   c.send_raw("this is not json\n");
   r = json::parse(c.read_line().value());
@@ -200,8 +204,43 @@ TEST_CASE("replies, error objects and counters for malformed and bad requests") 
   CHECK(k.internal_errors == 1);
   CHECK(k.replies_ok == 3);
   CHECK(k.requests == 13);
+  CHECK(k.busy == 0);
   CHECK(k.clients_active == 1);
   CHECK(k.to_json()["malformed"] == 4);
+  server.stop();
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("strict requests: a key twice, a mistyped or unknown argument never reach the handler") {
+  const std::string dir = test_dir();
+  TestHandler h;
+  ctl::ControlServer server(options_in(dir), h);
+  server.start();
+  ctl::ControlClient c(server.socket_path());
+  // The last "cmd" would be stop: the request is malformed, nothing is stopped.
+  c.send_raw("{\"id\":1,\"cmd\":\"status\",\"cmd\":\"stop\"}\n");
+  json r = json::parse(c.read_line().value());
+  CHECK(r["error"]["code"] == ctl::kErrorMalformed);
+  CHECK(r["error"]["message"] == "request has the key 'cmd' twice");
+  CHECK(h.stops == 0);
+  CHECK(h.calls == 0);
+  r = c.request({{"cmd", "load"}, {"instance", "a"}, {"library", "b"}, {"loop", "c"}, {"order", 1}, {"ports", {1}}});
+  CHECK(r["error"]["code"] == ctl::kErrorBadArgument);
+  CHECK(r["error"]["message"] == "'load': argument 'ports' must be an object of strings");
+  r = c.request({{"cmd", "param"}, {"action", "set"}, {"instance", "c"}, {"key", "k"}, {"value", "0x10"}});
+  CHECK(r["error"]["code"] == ctl::kErrorBadArgument);
+  r = c.request({{"cmd", "status"}, {"extra", 7}});
+  CHECK(r["error"]["message"] == "'status' takes no argument 'extra'");
+  CHECK(h.calls == 0);
+  // A handler's message with a NUL inside reaches the client whole.
+  r = c.request({{"cmd", "activate"}, {"instance", "x"}});
+  CHECK(r["error"]["code"] == ctl::kErrorFailed);
+  CHECK(r["error"]["message"] == std::string("before\0after", 12));
+  // The one stop that is well-formed does reach it.
+  CHECK(c.request({{"cmd", "stop"}})["error"]["code"] == ctl::kErrorInternal);
+  CHECK(h.stops == 1);
+  CHECK(server.counters().malformed == 1);
+  CHECK(server.counters().bad_argument == 3);
   server.stop();
   std::filesystem::remove_all(dir);
 }
@@ -260,7 +299,7 @@ TEST_CASE("a half-sent line times out with an error and a disconnect; idle clien
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("100 concurrent clients are all served; beyond max_clients they are refused") {
+TEST_CASE("100 concurrent clients are all served; beyond max_clients, with none idle, refused") {
   const std::string dir = test_dir();
   TestHandler h;
   auto opt = options_in(dir);
@@ -282,6 +321,10 @@ TEST_CASE("100 concurrent clients are all served; beyond max_clients they are re
   CHECK(ok == 100);
   CHECK(server.counters().clients_active == 100);
 
+  // Each one mid-request (half a line sent): none is idle, none yields its place.
+  const std::uint64_t read_before = server.counters().bytes_in;
+  for (int i = 0; i < 100; ++i) clients[i]->send_raw("{\"cmd\":");
+  REQUIRE(eventually([&] { return server.counters().bytes_in == read_before + 100 * 7; }));
   ctl::ControlClient extra(server.socket_path());
   const auto line = extra.read_line();
   REQUIRE(line.has_value());
@@ -310,12 +353,75 @@ TEST_CASE("100 concurrent clients are all served; beyond max_clients they are re
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("130 silent clients keep no one out: the idlest yields to a new client, and all time out") {
+  const std::string dir = test_dir();
+  TestHandler h;
+  auto opt = options_in(dir);
+  REQUIRE(opt.max_clients == 128);
+  REQUIRE(opt.idle_timeout == 30s);  // on by default
+  opt.idle_timeout = 1500ms;
+  ctl::ControlServer server(opt, h);
+  server.start();
+  std::vector<std::unique_ptr<ctl::ControlClient>> silent;
+  for (int i = 0; i < 130; ++i) silent.push_back(std::make_unique<ctl::ControlClient>(server.socket_path()));
+  REQUIRE(eventually([&] { return server.counters().connections_accepted == 130; }));
+  CHECK(server.counters().rejected_too_many_clients == 0);
+  CHECK(server.counters().idle_evictions == 2);  // the 129th and the 130th took the oldest places
+  CHECK(server.counters().clients_active == 128);
+  // A client that speaks now is served at once, while the silent ones are still there.
+  {
+    ctl::ControlClient c(server.socket_path());
+    CHECK(c.request({{"cmd", "status"}})["ok"] == true);
+  }
+  CHECK(server.counters().idle_evictions == 3);
+  // The first two were closed without a reply; the last one is still open.
+  CHECK_FALSE(silent[0]->read_line().has_value());
+  CHECK_FALSE(silent[1]->read_line().has_value());
+  // Then the idle timeout closes every silent one.
+  CHECK(eventually([&] { return server.counters().clients_active == 0; }, 20s));
+  CHECK(server.counters().idle_timeouts >= 127);
+  CHECK_FALSE(silent[129]->read_line().has_value());
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("a client over its request rate is answered busy, counted; the others are not") {
+  const std::string dir = test_dir();
+  TestHandler h;
+  auto opt = options_in(dir);
+  CHECK(opt.max_requests_per_s == 500.0);  // the default
+  opt.max_requests_per_s = 1;  // one a second: 40 pipelined requests would need 39 s to pass
+  ctl::ControlServer server(opt, h);
+  server.start();
+  ctl::ControlClient fast(server.socket_path());
+  std::string burst;
+  for (int i = 0; i < 40; ++i) burst += "{\"id\":" + std::to_string(i) + ",\"cmd\":\"status\"}\n";
+  fast.send_raw(burst);
+  int ok = 0, busy = 0;
+  for (int i = 0; i < 40; ++i) {
+    const json r = json::parse(fast.read_line().value());
+    CHECK(r["id"] == i);  // in order, each echoing its id
+    if (r["ok"] == true) ++ok;
+    if (!r["ok"].get<bool>() && r["error"]["code"] == ctl::kErrorBusy) ++busy;
+  }
+  CHECK(ok >= 1);
+  CHECK(busy >= 20);
+  CHECK(ok + busy == 40);
+  CHECK(h.calls == ok);  // a busy request is never handled
+  CHECK(server.counters().busy == static_cast<std::uint64_t>(busy));
+  CHECK(server.counters().to_json()["busy"] == busy);
+  // Another client has its own budget.
+  ctl::ControlClient other(server.socket_path());
+  CHECK(other.request({{"cmd", "status"}})["ok"] == true);
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("a client that never reads is disconnected; others keep being served") {
   const std::string dir = test_dir();
   TestHandler h;
   h.big = 8192;
   auto opt = options_in(dir);
   opt.max_output_bytes = 64 * 1024;
+  opt.max_requests_per_s = 0;  // the hog's requests are all handled: its replies pile up
   ctl::ControlServer server(opt, h);
   server.start();
   ctl::ControlClient hog(server.socket_path(), 2000ms);

@@ -3,6 +3,9 @@
 #include "core/daemon/views.h"
 
 #include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 namespace {
 struct Sample {
@@ -87,4 +90,17 @@ TEST_CASE("status, loops and stats views of a host") {
   const auto stats = crease::daemon::stats_view(host, nullptr);
   CHECK(stats["control"].is_null());
   CHECK(stats["loops"] == loops);
+  CHECK_FALSE(s.contains("control"));
+  // With a server: its clients and refusals, busy replies among them.
+  struct Nothing : crease::control::RequestHandler {
+    nlohmann::json handle(const nlohmann::json&) override { return {}; }
+  } nothing;
+  crease::control::ServerOptions o;
+  o.socket_path = "/tmp/crease_views_test_" + std::to_string(::getpid()) + "/s.sock";
+  crease::control::ControlServer server(o, nothing);
+  const auto with = crease::daemon::status_view(host, facts, 3'500'000'000, &server);
+  CHECK(with["control"] == nlohmann::json{{"clients", 0}, {"busy", 0}, {"refused", 0}});
+  CHECK(crease::daemon::stats_view(host, &server)["control"]["busy"] == 0);
+  server.stop();
+  std::filesystem::remove_all("/tmp/crease_views_test_" + std::to_string(::getpid()));
 }

@@ -117,8 +117,12 @@ TEST_CASE("creasectl talks to the control socket") {
   CHECK(r.status == 0);
   CHECK(daemon.last_request()["value"] == 2.5);
   CHECK(daemon.last_request()["action"] == "set");
+  // Parameters are numbers: a word or "0x10" never leaves creasectl (the daemon refuses strings).
   r = creasectl(sock + "param set counter mode fast");
-  CHECK(daemon.last_request()["value"] == "fast");
+  CHECK(r.status == 2);
+  CHECK(r.err.find("not a number: 'fast'") != std::string::npos);
+  CHECK(daemon.last_request()["value"] == 2.5);
+  CHECK(creasectl(sock + "param set counter mode 0x10").status == 2);
   r = creasectl(sock + "param get counter step");
   CHECK(daemon.last_request() ==
         json{{"cmd", "param"}, {"id", 1}, {"action", "get"}, {"instance", "counter"}, {"key", "step"}});

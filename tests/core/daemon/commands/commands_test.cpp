@@ -4,6 +4,8 @@
 
 #include <doctest/doctest.h>
 
+#include <limits>
+
 #include "core/control/protocol.h"
 
 namespace ctl = crease::control;
@@ -43,7 +45,7 @@ TEST_CASE("handlers answer through the context: stop says why, views read the ho
         "failed: unload: no instance named 'x'");
 }
 
-TEST_CASE("param set takes a number or a string holding only a number") {
+TEST_CASE("param set takes a JSON number only: a string is never read as one") {
   crease::PluginHost host({});
   crease::daemon::RunFacts facts;
   CommandContext ctx{host, facts, nullptr, [](const std::string&) {}};
@@ -53,16 +55,34 @@ TEST_CASE("param set takes a number or a string holding only a number") {
       param({{"cmd", "param"}, {"instance", "x"}, {"action", "set"}, {"key", "k"}, {"value", value}}, ctx);
     });
   };
-  for (const nlohmann::json& bad : {nlohmann::json("3x"), nlohmann::json("fast"), nlohmann::json(""),
-                                    nlohmann::json("1e999"), nlohmann::json(true)}) {
+  for (const nlohmann::json& bad : {nlohmann::json("0x10"), nlohmann::json("2.5"), nlohmann::json("fast"),
+                                    nlohmann::json(""), nlohmann::json(true),
+                                    nlohmann::json(std::numeric_limits<double>::infinity())}) {
     CAPTURE(bad);
     CHECK(set(bad) == "bad_argument: param set: value must be a number");
   }
   // Numbers get as far as the host, which has no such instance.
-  CHECK(set("2.5").rfind("failed: ", 0) == 0);
+  CHECK(set(2.5).rfind("failed: ", 0) == 0);
   CHECK(set(3).rfind("failed: ", 0) == 0);
   CHECK(code_of([&] { param({{"cmd", "param"}, {"instance", "x"}, {"action", "reset"}, {"key", "k"}}, ctx); }) ==
         "bad_argument: param: action must be get or set, not 'reset'");
+}
+
+TEST_CASE("load: order in the configuration's range, ports an object of strings") {
+  crease::PluginHost host({});
+  crease::daemon::RunFacts facts;
+  CommandContext ctx{host, facts, nullptr, [](const std::string&) {}};
+  const auto load = crease::daemon::find_command("load");
+  const nlohmann::json base = {{"cmd", "load"}, {"instance", "a"}, {"library", "b"}, {"loop", "c"}, {"order", 1}};
+  auto with = [&](const char* key, nlohmann::json v) {
+    nlohmann::json r = base;
+    r[key] = std::move(v);
+    return code_of([&] { load(r, ctx); });
+  };
+  CHECK(with("order", 3'000'000'000LL) == "bad_argument: load: order must be in [-1000000, 1000000]");
+  CHECK(with("ports", nlohmann::json::array({1})) == "bad_argument: load: 'ports' must be an object of strings");
+  CHECK(with("ports", {{"out", 1}}) == "bad_argument: load: ports values must be strings");
+  CHECK(with("ports", {{"out", "x"}}).rfind("failed: ", 0) == 0);  // as far as the host
 }
 
 TEST_CASE("params arguments must be objects and are named after the instance") {
