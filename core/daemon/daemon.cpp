@@ -15,6 +15,7 @@
 #include "core/control/socket_path.h"
 #include "core/daemon/commands/commands.h"
 #include "core/daemon/console.h"
+#include "core/daemon/startup_stop.h"
 #include "core/errors.h"
 #include "rt/clock.h"
 #include "rt/rt_setup.h"
@@ -84,6 +85,8 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
   for (const auto& l : config_.loops) host_->add_loop({l.name, l.rate_hz, l.priority, l.cpu, l.phase_ns});
   for (std::size_t i = 0; i < config_.plugins.size(); ++i) {
     const auto& p = config_.plugins[i];
+    check_startup_stop("before plugin " + std::to_string(i + 1) + " of " + std::to_string(config_.plugins.size()) +
+                       " ('" + p.name + "')");
     try {
       host_->add_instance(to_spec(p, config_.file, i));
     } catch (const std::exception& e) {
@@ -103,10 +106,12 @@ Daemon::~Daemon() {
 
 int Daemon::run() {
   const auto& d = config_.daemon;
+  check_startup_stop("after loading every plugin");
   if (d.lock_memory) {
     const auto step = rt::lock_memory(static_cast<std::size_t>(d.prefault_heap_mb) << 20);
     facts_.mlockall_applied = step.applied;
     log_step(step);
+    check_startup_stop("after locking and prefaulting memory");
   }
   log_step(non_rt_step_);
   rt::DmaLatencyRequest dma;
@@ -123,6 +128,7 @@ int Daemon::run() {
   so.max_clients = static_cast<std::size_t>(d.control.max_clients);
   server_ = std::make_unique<control::ControlServer>(so, *this);
   server_->start();  // before the loops: its threads' creation is done when they take deadlines
+  check_startup_stop("before starting the loops");
 
   facts_.start_ns = rt::now_ns();
   facts_.sched_fifo_applied = true;

@@ -38,7 +38,8 @@ class Daemon final : public control::RequestHandler {
 
   // Starts the loops and the control server; returns when stopped (signal, `stop`, duration,
   // safety policy). Drives outputs safe, deactivates in reverse order, writes the reports.
-  // Returns the exit status (0).
+  // Returns the exit status (0). A SIGINT/SIGTERM pending before the loops start throws
+  // StartupStopped (startup_stop.h), as does one during construction, between plugins.
   int run();
   void request_stop() noexcept { stop_.store(true); }
 

@@ -1,8 +1,9 @@
 // creased: the Crease daemon.
 //   creased --config FILE [--socket PATH] [--duration SECONDS] [--report-dir DIR]
 //           [--log-level LEVEL] [--plugin-dir DIR]... [--no-progress] [--set INSTANCE.KEY=VALUE]...
-// Exit status: 0 after a clean stop, 2 for a configuration or plugin error (nothing started),
-// 1 for any other failure.
+// Exit status: 0 after a clean stop (also a SIGINT/SIGTERM during start-up: what was built is
+// unwound, no loop runs), 2 for a configuration or plugin error (nothing started), 1 for any
+// other failure.
 #include <signal.h>
 
 #include <CLI/CLI.hpp>
@@ -16,6 +17,7 @@
 #include "core/config/daemon_config.h"
 #include "core/control/control_server.h"
 #include "core/daemon/daemon.h"
+#include "core/daemon/startup_stop.h"
 #include "core/errors.h"
 
 int main(int argc, char** argv) {
@@ -58,13 +60,21 @@ int main(int argc, char** argv) {
   try {
     crease::config::DaemonConfig config = crease::config::load_daemon_config(config_file);
     for (const std::string& o : overrides) crease::config::override_param(config, o);
+    crease::daemon::check_startup_stop("after reading the configuration");
     daemon = std::make_unique<crease::daemon::Daemon>(std::move(config), options);
+  } catch (const crease::daemon::StartupStopped& e) {  // what was built is unwound by now
+    std::printf("creased: %s; no loop ran\n", e.what());
+    return 0;
   } catch (const crease::Error& e) {  // ConfigError, LoadError, PortError
     std::fprintf(stderr, "creased: %s\n", e.what());
     return 2;
   }
   try {
     return daemon->run();
+  } catch (const crease::daemon::StartupStopped& e) {
+    daemon.reset();  // plugins deactivated and unloaded, the socket removed
+    std::printf("creased: %s; no loop ran\n", e.what());
+    return 0;
   } catch (const crease::control::ControlError& e) {
     std::fprintf(stderr, "creased: control socket: %s\n", e.what());
     return 1;
