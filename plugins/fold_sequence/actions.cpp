@@ -1,0 +1,282 @@
+// The machine's entry and exit actions: the goals each state of seed 000 Fig. 7 sends to the
+// arms' motions (arm_goal), the hands' force controllers (hand_goal) and the sheet model
+// (sheet_crease, sheet_memorize). Points from the fold file, in the sheet frame arm_motion
+// resolves when each motion starts; the parking poses in the world frame.
+#include <cmath>
+
+#include "plugins/fold_sequence/machine.h"
+#include "plugins/fold_sequence/sheet_geometry.h"
+
+namespace crease::fold {
+namespace {
+
+void set_limits(ArmGoal& g, const MotionLimits& l) noexcept {
+  g.speed_mm_s = l.speed_mm_s;
+  g.accel_mm_s2 = l.accel_mm_s2;
+  g.angular_speed_rad_s = l.angular_speed_rad_s;
+  g.angular_accel_rad_s2 = l.angular_accel_rad_s2;
+  g.stop_accel_mm_s2 = l.stop_accel_mm_s2;
+}
+
+}  // namespace
+
+void Machine::arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
+                       const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept {
+  if (out.arm_count[side] >= Outbox::kPerPort) {
+    out.overflow = true;
+    return;
+  }
+  ArmGoal& g = out.arm[side][out.arm_count[side]++];
+  g = ArmGoal{};
+  g.timestamp_ns = m_.last_ns;
+  g.id = m_.next_id++;
+  g.kind = ArmGoal::move;
+  g.tool = tool;
+  g.frame = frame;
+  g.point_count = 1;
+  g.stop_on = stop_fingers != 0 ? ArmGoal::contact_onset : ArmGoal::stop_none;
+  g.stop_fingers = stop_fingers != 0 ? stop_fingers : 0x1f;
+  set_limits(g, lim);
+  for (int c = 0; c < 3; ++c) g.position_mm[0][c] = p[c];
+  for (int c = 0; c < 4; ++c) g.orientation[0][c] = q[c];
+  m_.arm_id[side] = g.id;
+  m_.arm_has_target[side] = 1;
+  m_.arm_frame[side] = frame;
+  m_.arm_tool[side] = tool;
+  for (int c = 0; c < 3; ++c) m_.arm_target[side][c] = p[c];
+  for (int c = 0; c < 4; ++c) m_.arm_orientation[side][c] = q[c];
+}
+
+void Machine::arm_stop(int side, Outbox& out) noexcept {
+  if (out.arm_count[side] >= Outbox::kPerPort) {
+    out.overflow = true;
+    return;
+  }
+  ArmGoal& g = out.arm[side][out.arm_count[side]++];
+  g = ArmGoal{};
+  g.timestamp_ns = m_.last_ns;
+  g.id = m_.next_id++;
+  g.kind = ArmGoal::stop;
+  m_.arm_id[side] = 0;  // a stop is not waited for by id: the arm is still when it no longer moves
+}
+
+void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
+  if (!m_.arm_has_target[side]) return;  // never moved: where it parked
+  double p[3] = {m_.arm_target[side][0], m_.arm_target[side][1], m_.arm_target[side][2]};
+  // Up: the world's +z, the sheet frame's -z (z = u x v points into the table).
+  p[2] += m_.arm_frame[side] == ArmGoal::sheet ? -lift_mm : lift_mm;
+  const double q[4] = {m_.arm_orientation[side][0], m_.arm_orientation[side][1], m_.arm_orientation[side][2],
+                       m_.arm_orientation[side][3]};
+  arm_move(side, m_.arm_tool[side], m_.arm_frame[side], p, q, spec_.retreat, 0, out);
+}
+
+void Machine::arm_park(int side, Outbox& out) noexcept {
+  arm_move(side, m_.arm_has_target[side] ? m_.arm_tool[side] : 0, ArmGoal::world, spec_.park_mm[side],
+           spec_.park_orientation[side], spec_.retreat, 0, out);
+}
+
+void Machine::push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) noexcept {
+  if (out.hand_count[side] >= Outbox::kPerPort) {
+    out.overflow = true;
+    return;
+  }
+  g.timestamp_ns = m_.last_ns;
+  g.id = m_.next_id++;
+  out.hand[side][out.hand_count[side]++] = g;
+  m_.hand_id[side] = g.id;
+  m_.hand_mode[side] = g.mode;
+  m_.hand_refused0[side] = in.hand[side] != nullptr ? in.hand[side]->goals_refused : 0;
+}
+
+void Machine::hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out) noexcept {
+  HandGoal g{};
+  g.mode = HandMode::posture;
+  g.ramp_s = static_cast<float>(spec_.posture_ramp_s);
+  for (int j = 0; j < kHandJoints; ++j) g.target_rad[j] = target_rad[j];
+  push_hand(side, g, in, out);
+}
+
+void Machine::hand_force(int side, std::uint8_t fingers, double force_n, const Sensing& in, Outbox& out) noexcept {
+  HandGoal g{};
+  g.mode = HandMode::force;
+  g.fingers = static_cast<std::uint8_t>(fingers & 0x0f);  // the thumb never presses
+  g.force_n = static_cast<float>(force_n);
+  g.ramp_s = static_cast<float>(spec_.force_ramp_s);
+  push_hand(side, g, in, out);
+}
+
+void Machine::hand_hold(int side, const Sensing& in, Outbox& out) noexcept {
+  HandGoal g{};
+  g.mode = HandMode::hold;
+  push_hand(side, g, in, out);
+}
+
+void Machine::approach(int side, const ContactStep& c, Outbox& out) noexcept {
+  const double p[3] = {c.at_mm[0], c.at_mm[1], -c.approach_height_mm};
+  arm_move(side, c.tool, ArmGoal::sheet, p, c.orientation, spec_.approach, 0, out);
+}
+
+void Machine::descend(int side, const ContactStep& c, Outbox& out) noexcept {
+  const double p[3] = {c.at_mm[0], c.at_mm[1], c.contact_depth_mm};  // below the surface: stops on contact
+  arm_move(side, c.tool, ArmGoal::sheet, p, c.orientation, spec_.contact, c.fingers, out);
+}
+
+void Machine::stop_for_pause(Outbox& out) noexcept {
+  for (int s = 0; s < 2; ++s) {
+    arm_stop(s, out);
+    m_.hand_id[s] = 0;
+  }
+  // Hands that press keep their targets (hold); the others keep their posture as it is.
+  const Sensing none{};
+  for (int s = 0; s < 2; ++s)
+    if (m_.hand_mode[s] == HandMode::force) hand_hold(s, none, out);
+  for (int s = 0; s < 2; ++s) m_.hand_id[s] = 0;
+}
+
+void Machine::exit(S s, const Sensing& in, Outbox& out) noexcept {
+  (void)in;
+  (void)out;
+  (void)s;  // no state leaves anything behind: its goals are replaced by the next state's
+}
+
+void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
+  m_.elapsed_ns[static_cast<int>(s)] = 0;
+  if (is_leaf(s)) {
+    m_.arm_id[0] = m_.arm_id[1] = 0;  // the goals waited for are the ones this state sends
+    m_.hand_id[0] = m_.hand_id[1] = 0;
+  }
+  const FoldSpec& f = spec_;
+  switch (s) {
+    case S::fold:
+      m_.via = 0;
+      m_.vision_bad_since_ns = 0;
+      m_.abort_reason = Reason::none;
+      break;
+    case S::shift_approach:
+      hand_posture(kRight, f.open_rad, in, out);
+      hand_posture(kLeft, f.open_rad, in, out);
+      approach(kRight, f.shift, out);
+      break;
+    case S::shift_contact: descend(kRight, f.shift, out); break;
+    case S::shift_press: hand_force(kRight, f.shift.fingers, f.shift.force_n, in, out); break;
+    case S::shift_slide: {
+      double d[2] = {0, 0};
+      const double len = slide_length(in, d);
+      if (!std::isfinite(len)) d[0] = d[1] = 0;  // the guard saw a sheet; a stale one here moves nothing
+      const double p[3] = {f.shift.at_mm[0] + d[0], f.shift.at_mm[1] + d[1], -f.slide_height_mm};
+      arm_move(kRight, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+      break;
+    }
+    case S::grasp_fixate: hand_force(kRight, f.shift.fingers, f.fixate_force_n, in, out); break;
+    case S::grasp_above:
+      arm_move(kLeft, f.grasp_tool, ArmGoal::sheet, f.grasp_above_mm, f.grasp_orientation, f.approach, 0, out);
+      break;
+    case S::grasp_reach:
+      arm_move(kLeft, f.grasp_tool, ArmGoal::sheet, f.grasp_at_mm, f.grasp_orientation, f.contact, 0, out);
+      break;
+    case S::grasp_pinch: hand_posture(kLeft, f.pinch_rad, in, out); break;
+    case S::bend:
+      // The crease the fold intends, in the tracked sheet's coordinates, so the model can bend.
+      out.crease = SheetCreaseEvent{};
+      out.crease.timestamp_ns = m_.last_ns;
+      out.crease.op = SheetCreaseEvent::Op::add;
+      for (int c = 0; c < 2; ++c) {
+        out.crease.a_mm[c] = static_cast<float>(f.fold_line_mm[0][c]);
+        out.crease.b_mm[c] = static_cast<float>(f.fold_line_mm[1][c]);
+      }
+      out.has_crease = true;
+      m_.crease_count0 = in.sheet != nullptr ? in.sheet->crease_count : 0;
+      break;
+    case S::follow_via:
+      if (m_.self_entry) ++m_.via;  // the next via point; re-entered on resume: the same one
+      arm_move(kLeft, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], f.via_orientation[m_.via], f.fold, 0, out);
+      break;
+    case S::bend_crease: m_.via = 0; break;
+    case S::layer_approach: approach(kLeft, f.fixate_layer, out); break;
+    case S::layer_contact: descend(kLeft, f.fixate_layer, out); break;
+    case S::layer_press: hand_force(kLeft, f.fixate_layer.fingers, f.fixate_layer.force_n, in, out); break;
+    case S::refix_open: hand_posture(kRight, f.open_rad, in, out); break;
+    case S::refix_lift: arm_lift(kRight, f.release_lift_mm, out); break;
+    case S::refix_approach: approach(kRight, f.refixate, out); break;
+    case S::refix_contact: descend(kRight, f.refixate, out); break;
+    case S::refix_press: hand_force(kRight, f.refixate.fingers, f.refixate.force_n, in, out); break;
+    case S::swipe_open:
+    case S::harden_open: hand_posture(kLeft, f.open_rad, in, out); break;
+    case S::swipe_lift:
+    case S::harden_lift: arm_lift(kLeft, f.release_lift_mm, out); break;
+    case S::swipe_approach: approach(kLeft, f.swipe, out); break;
+    case S::swipe_contact: descend(kLeft, f.swipe, out); break;
+    case S::swipe_press: hand_force(kLeft, f.swipe.fingers, f.swipe.force_n, in, out); break;
+    case S::swipe_slide: {
+      const double p[3] = {f.swipe_to_mm[0], f.swipe_to_mm[1], -f.slide_height_mm};
+      arm_move(kLeft, f.swipe.tool, ArmGoal::sheet, p, f.swipe.orientation, f.slide, 0, out);
+      break;
+    }
+    case S::harden_approach: {
+      // The stroke along the crease as the model has it (nearest to the intended line; the
+      // intended line when the model has none), inset from its ends, offset across it.
+      double a[2] = {f.fold_line_mm[0][0], f.fold_line_mm[0][1]};
+      double b[2] = {f.fold_line_mm[1][0], f.fold_line_mm[1][1]};
+      if (in.sheet != nullptr) (void)nearest_crease(*in.sheet, a, b);
+      const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
+      const double dir[2] = {len > 0 ? (b[0] - a[0]) / len : 1.0, len > 0 ? (b[1] - a[1]) / len : 0.0};
+      const double nrm[2] = {-dir[1], dir[0]};
+      const double inset = len > 2 * f.harden_inset_mm ? f.harden_inset_mm : 0.0;
+      for (int c = 0; c < 2; ++c) {
+        m_.harden_a[c] = a[c] + dir[c] * inset + nrm[c] * f.harden_offset_mm;
+        m_.harden_b[c] = b[c] - dir[c] * inset + nrm[c] * f.harden_offset_mm;
+      }
+      ContactStep h = f.harden;
+      h.at_mm[0] = m_.harden_a[0];
+      h.at_mm[1] = m_.harden_a[1];
+      approach(kLeft, h, out);
+      break;
+    }
+    case S::harden_contact: {
+      ContactStep h = f.harden;
+      h.at_mm[0] = m_.harden_a[0];
+      h.at_mm[1] = m_.harden_a[1];
+      descend(kLeft, h, out);
+      break;
+    }
+    case S::harden_press: hand_force(kLeft, f.harden.fingers, f.harden.force_n, in, out); break;
+    case S::harden_slide: {
+      const double p[3] = {m_.harden_b[0], m_.harden_b[1], -f.slide_height_mm};
+      arm_move(kLeft, f.harden.tool, ArmGoal::sheet, p, f.harden.orientation, f.slide, 0, out);
+      break;
+    }
+    case S::finish_memorize:
+      out.memorize = SheetMemorizeEvent{};
+      out.memorize.timestamp_ns = m_.last_ns;
+      out.memorize.whole_sheet = true;
+      out.has_memorize = true;
+      m_.sheet_step0 = in.sheet != nullptr ? in.sheet->step : 0;
+      break;
+    case S::finish_open:
+    case S::abort_open:
+      hand_posture(kRight, f.open_rad, in, out);
+      hand_posture(kLeft, f.open_rad, in, out);
+      break;
+    case S::finish_lift:
+    case S::abort_lift:
+      arm_lift(kRight, f.release_lift_mm, out);
+      arm_lift(kLeft, f.release_lift_mm, out);
+      break;
+    case S::finish_park:
+    case S::abort_park:
+      arm_park(kRight, out);
+      arm_park(kLeft, out);
+      break;
+    case S::abort: ++m_.aborts; break;
+    case S::abort_stop:
+      // Stop force first (hold the targets), and the arms where they are.
+      hand_hold(kRight, in, out);
+      hand_hold(kLeft, in, out);
+      arm_stop(kRight, out);
+      arm_stop(kLeft, out);
+      break;
+    default: break;
+  }
+}
+
+}  // namespace crease::fold

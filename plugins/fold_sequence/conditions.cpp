@@ -1,0 +1,162 @@
+// The machine's events, guards and fault checks: every success condition is a fact of the
+// sensing about the goal the state sent (its id echoed by the controller), never elapsed time.
+#include <cmath>
+
+#include "plugins/fold_sequence/machine.h"
+#include "plugins/fold_sequence/sheet_geometry.h"
+
+namespace crease::fold {
+namespace {
+
+bool fresh(std::int64_t stamp_ns, std::int64_t now_ns, double max_age_s) noexcept {
+  return static_cast<double>(now_ns - stamp_ns) * 1e-9 <= max_age_s;
+}
+
+bool moving(const ArmMotionStatus* a) noexcept {
+  return a != nullptr && (a->state == ArmMotionStatus::checking || a->state == ArmMotionStatus::running ||
+                          a->state == ArmMotionStatus::stopping);
+}
+
+// The goal `id` ended one way or another (reached, stopped, refused, aborted).
+bool ended(const ArmMotionStatus* a, std::uint32_t id) noexcept {
+  if (id == 0 || a == nullptr) return true;
+  if (a->last_refused_id == id) return true;
+  return a->goal_id == id && !moving(a) && a->state != ArmMotionStatus::idle;
+}
+
+}  // namespace
+
+bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
+  auto reached = [&](int s) {
+    const ArmMotionStatus* a = in.arm[s];
+    return m_.arm_id[s] == 0 ||
+           (a != nullptr && a->goal_id == m_.arm_id[s] && a->state == ArmMotionStatus::reached);
+  };
+  auto contact_stop = [&](int s) {
+    const ArmMotionStatus* a = in.arm[s];
+    return a != nullptr && m_.arm_id[s] != 0 && a->goal_id == m_.arm_id[s] &&
+           a->state == ArmMotionStatus::stopped_on_contact;
+  };
+  auto settled = [&](int s) {
+    const HandControlStatus* h = in.hand[s];
+    return h != nullptr && m_.hand_id[s] != 0 && h->goal_id == m_.hand_id[s] && h->mode == HandMode::force &&
+           h->settled != 0;
+  };
+  auto posed = [&](int s) {
+    const HandControlStatus* h = in.hand[s];
+    if (m_.hand_id[s] == 0) return true;
+    return h != nullptr && h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture && h->max_step_rad <= 1e-6f;
+  };
+  switch (ev) {
+    case Ev::start: return m_.start_pending != 0;
+    case Ev::timeout: return timed_out(owner);
+    case Ev::fault: return detected_ != Reason::none;
+    case Ev::arm_r_reached: return m_.arm_id[kRight] != 0 && reached(kRight);
+    case Ev::arm_l_reached: return m_.arm_id[kLeft] != 0 && reached(kLeft);
+    case Ev::arms_reached: return reached(kRight) && reached(kLeft);
+    case Ev::arm_r_contact: return contact_stop(kRight);
+    case Ev::arm_l_contact: return contact_stop(kLeft);
+    case Ev::hand_r_settled: return settled(kRight);
+    case Ev::hand_l_settled: return settled(kLeft);
+    case Ev::hand_r_posed: return m_.hand_id[kRight] != 0 && posed(kRight);
+    case Ev::hand_l_posed: return m_.hand_id[kLeft] != 0 && posed(kLeft);
+    case Ev::hands_posed: return posed(kRight) && posed(kLeft);
+    case Ev::pinched: {
+      const ContactState* c = in.contact[kLeft];
+      const HandControlStatus* h = in.hand[kLeft];
+      return c != nullptr && h != nullptr && h->goal_id == m_.hand_id[kLeft] && c->in_contact != 0 &&
+             (c->fingers & spec_.pinch_fingers) == spec_.pinch_fingers;
+    }
+    case Ev::crease_acked: return in.sheet != nullptr && in.sheet->crease_count > m_.crease_count0;
+    case Ev::memorized: return in.sheet != nullptr && in.sheet->step >= m_.sheet_step0 + 2;
+    case Ev::stopped:
+      for (int s = 0; s < 2; ++s) {
+        const HandControlStatus* h = in.hand[s];
+        const bool hand_ok = h == nullptr || m_.hand_id[s] == 0 || h->mode == HandMode::retreat ||
+                             (h->goal_id == m_.hand_id[s] && h->mode == HandMode::hold) ||
+                             h->goals_refused > m_.hand_refused0[s];
+        if (!hand_ok || moving(in.arm[s])) return false;
+      }
+      return true;
+    case Ev::arms_done: return ended(in.arm[kRight], m_.arm_id[kRight]) && ended(in.arm[kLeft], m_.arm_id[kLeft]);
+    case Ev::always: return true;
+  }
+  return false;
+}
+
+double Machine::slide_length(const Sensing& in, double d_sheet[2]) const noexcept {
+  SheetFrame f;
+  double corner[3];
+  if (in.sheet == nullptr || !sheet_frame(*in.sheet, f) || !node_at(*in.sheet, spec_.corner_mm[0], spec_.corner_mm[1], corner))
+    return std::nan("");
+  // The corner's way to its target on the table plane, expressed along the sheet's axes.
+  const double d[3] = {spec_.corner_target_mm[0] - corner[0], spec_.corner_target_mm[1] - corner[1], 0.0};
+  d_sheet[0] = d[0] * f.x[0] + d[1] * f.x[1] + d[2] * f.x[2];
+  d_sheet[1] = d[0] * f.y[0] + d[1] * f.y[1] + d[2] * f.y[2];
+  return std::hypot(d[0], d[1]);
+}
+
+bool Machine::passes(Guard g, const Sensing& in) const noexcept {
+  double d[2];
+  switch (g) {
+    case Guard::none: return true;
+    case Guard::slide_needed: {
+      const double l = slide_length(in, d);
+      return l > spec_.shift_tolerance_mm && l <= spec_.max_slide_mm;
+    }
+    case Guard::slide_short: return slide_length(in, d) <= spec_.shift_tolerance_mm;
+    case Guard::slide_too_long: return slide_length(in, d) > spec_.max_slide_mm;
+    case Guard::right_armed:
+    case Guard::left_armed: {
+      const ContactState* c = in.contact[g == Guard::right_armed ? kRight : kLeft];
+      return c != nullptr && c->armed != 0 && c->healthy != 0;
+    }
+    case Guard::more_via: return m_.via + 1 < spec_.via_count;
+    case Guard::last_via: return m_.via + 1 >= spec_.via_count;
+  }
+  return false;
+}
+
+Reason Machine::fault(const Sensing& in) noexcept {
+  const std::int64_t now = in.now_ns;
+  // The sheet as vision and the model see it: stale or unobserved for longer than the bound.
+  const SheetState* sh = in.sheet;
+  const bool seen = sh != nullptr && fresh(sh->timestamp_ns, now, spec_.sheet_max_age_s) &&
+                    sh->observations >= spec_.min_observations;
+  if (seen) {
+    m_.vision_bad_since_ns = 0;
+  } else if (m_.vision_bad_since_ns == 0) {
+    m_.vision_bad_since_ns = now;
+  } else if (static_cast<double>(now - m_.vision_bad_since_ns) * 1e-9 > spec_.vision_lost_max_s) {
+    return Reason::vision_lost;
+  }
+  for (int s = 0; s < 2; ++s) {
+    const HandControlStatus* h = in.hand[s];
+    const ArmMotionStatus* a = in.arm[s];
+    const ContactState* c = in.contact[s];
+    // Controllers that do not answer, or answer that their inputs are bad: a device fault.
+    if (h == nullptr || !fresh(h->timestamp_ns, now, spec_.status_max_age_s)) return Reason::device_fault;
+    if (a == nullptr || !fresh(a->timestamp_ns, now, spec_.status_max_age_s)) return Reason::device_fault;
+    if (c == nullptr || !fresh(c->timestamp_ns, now, spec_.status_max_age_s) || c->healthy == 0)
+      return Reason::device_fault;
+    if (h->inhibit == HandInhibit::force_limit) return Reason::force_limit;
+    if (h->inhibit != HandInhibit::none) return Reason::device_fault;
+    if (m_.hand_id[s] != 0 && h->goals_refused > m_.hand_refused0[s]) return Reason::goal_refused;
+    const std::uint32_t id = m_.arm_id[s];
+    if (id == 0) continue;
+    if (a->last_refused_id == id || (a->goal_id == id && (a->state == ArmMotionStatus::unreachable ||
+                                                          a->state == ArmMotionStatus::refused))) {
+      const auto why = static_cast<ArmMotionReason>(a->last_refused_id == id ? a->last_refusal : a->reason);
+      return why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed ? Reason::unreachable
+                                                                                         : Reason::goal_refused;
+    }
+    if (a->goal_id == id && a->state == ArmMotionStatus::aborted) {
+      const auto why = static_cast<ArmMotionReason>(a->reason);
+      return why == ArmMotionReason::arm_fault || why == ArmMotionReason::arm_stale ? Reason::device_fault
+                                                                                     : Reason::motion_aborted;
+    }
+  }
+  return Reason::none;
+}
+
+}  // namespace crease::fold

@@ -1,0 +1,93 @@
+#include "plugins/fold_sequence/fold_sequence_plugin.h"
+
+#include <cmath>
+#include <cstring>
+
+namespace crease::fold {
+
+void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
+  spec_ = load_fold_file(p.get_path("fold"));
+  auto_start_ = p.get<bool>("auto_start", false);
+  machine_ = std::make_unique<Machine>(spec_);
+  outbox_ = std::make_unique<Outbox>();
+  ports.tunable("command", &command_, 0.0, 5.0);
+  const char* side[2] = {"r", "l"};
+  for (int s = 0; s < 2; ++s) {
+    const std::string x = side[s];
+    arm_status_[s] = ports.latest_input<ArmMotionStatus>("arm_" + x + "_status");
+    hand_status_[s] = ports.latest_input<HandControlStatus>("hand_" + x + "_status");
+    contact_[s] = ports.latest_input<ContactState>("contact_" + x + "_state");
+    arm_goal_[s] = ports.queue_output<ArmGoal>("arm_" + x + "_goal");
+    hand_goal_[s] = ports.queue_output<HandGoal>("hand_" + x + "_goal");
+  }
+  sheet_ = ports.latest_input<SheetState>("sheet_state");
+  crease_ = ports.queue_output<SheetCreaseEvent>("sheet_crease");
+  memorize_ = ports.queue_output<SheetMemorizeEvent>("sheet_memorize");
+  status_ = ports.latest_output<SequenceStatus>("sequence_status", SequenceStatus{});
+}
+
+void FoldSequencePlugin::activate() { started_ = false; }
+
+std::string FoldSequencePlugin::validate_param(std::string_view key, double value) {
+  if (key == "command" && value != std::floor(value))
+    return "command: 1 start, 2 pause, 3 resume, 4 abort, 5 step (got " + format_number(value) + ")";
+  return {};
+}
+
+Status FoldSequencePlugin::update(const Cycle& c) {
+  if (auto_start_ && !started_) machine_->command(Command::start);
+  started_ = true;
+  if (command_ != 0) {
+    machine_->command(static_cast<Command>(static_cast<int>(command_)));
+    command_ = 0;
+  }
+  Sensing in;
+  in.now_ns = c.time_ns;
+  for (int s = 0; s < 2; ++s) {
+    (void)arm_status_[s].poll();
+    (void)hand_status_[s].poll();
+    (void)contact_[s].poll();
+    if (arm_status_[s].has_value()) in.arm[s] = &arm_status_[s].value();
+    if (hand_status_[s].has_value()) in.hand[s] = &hand_status_[s].value();
+    if (contact_[s].has_value()) in.contact[s] = &contact_[s].value();
+  }
+  (void)sheet_.poll();
+  if (sheet_.has_value()) in.sheet = &sheet_.value();
+
+  Outbox& out = *outbox_;
+  machine_->step(in, out);
+  bool lost = out.overflow;
+  for (int s = 0; s < 2; ++s) {
+    for (int i = 0; i < out.arm_count[s]; ++i) lost |= !arm_goal_[s].try_push(out.arm[s][i]);
+    for (int i = 0; i < out.hand_count[s]; ++i) lost |= !hand_goal_[s].try_push(out.hand[s][i]);
+  }
+  if (out.has_crease) lost |= !crease_.try_push(out.crease);
+  if (out.has_memorize) lost |= !memorize_.try_push(out.memorize);
+  if (lost) machine_->fail(Reason::command_lost);
+
+  machine_->fill_status(status_value_, c.time_ns);
+  status_.write(status_value_, c.time_ns);
+  if (status_value_.transitions != logged_transitions_) {
+    logged_transitions_ = status_value_.transitions;
+    log_rt(rt::LogLevel::info, status_value_.path, static_cast<std::int64_t>(status_value_.transitions));
+  }
+  return status_value_.phase == SequenceStatus::aborted ? Status::degraded : Status::ok;
+}
+
+std::size_t FoldSequencePlugin::save_state(std::span<std::byte> out) const noexcept {
+  if (out.size() < sizeof(Memory)) return SIZE_MAX;
+  std::memcpy(out.data(), &machine_->memory(), sizeof(Memory));
+  return sizeof(Memory);
+}
+
+bool FoldSequencePlugin::load_state(std::span<const std::byte> in) noexcept {
+  if (in.size() != sizeof(Memory)) return false;
+  Memory m;
+  std::memcpy(&m, in.data(), sizeof(Memory));
+  if (!machine_->restore(m)) return false;
+  logged_transitions_ = m.transitions;
+  started_ = true;  // a swapped-in instance goes on; it does not start the fold again
+  return true;
+}
+
+}  // namespace crease::fold

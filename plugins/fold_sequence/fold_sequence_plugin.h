@@ -1,0 +1,65 @@
+// The fold_sequence plugin: the machine (machine.h) between the control loop's ports. Ordered
+// after the controllers it reads (their statuses are this cycle's) in the control loop; its
+// goals are read by them in the next cycle. Declared here so that tests drive it directly on
+// a PortRegistry of their own; fold_sequence_entry.cpp registers it.
+//
+// Ports (the plugin's names; the configuration remaps them):
+//   arm_r_status, arm_l_status    latest in   crease::ArmMotionStatus  (arm_motion per arm)
+//   hand_r_status, hand_l_status  latest in   crease::HandControlStatus (force_controller per hand)
+//   contact_r_state, contact_l_state latest in crease::ContactState   (contact_controller per hand)
+//   sheet_state                   latest in   crease::SheetState (the model's; 164 kB copied per new frame)
+//   arm_r_goal, arm_l_goal        queue out   crease::ArmGoal
+//   hand_r_goal, hand_l_goal      queue out   crease::HandGoal
+//   sheet_crease                  queue out   crease::SheetCreaseEvent
+//   sheet_memorize                queue out   crease::SheetMemorizeEvent
+//   sequence_status               latest out  crease::SequenceStatus (creasectl status shows it)
+// Parameters: fold (path of a sequence file, required), auto_start (false). Tunable `command`
+// (0..5, integers): 1 start, 2 pause, 3 resume, 4 abort, 5 step; read once and reset to 0 by
+// the plugin (`creasectl sequence start|pause|resume|abort|step` sets it).
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "core/plugin.h"
+#include "core/port.h"
+#include "plugins/fold_sequence/fold_spec.h"
+#include "plugins/fold_sequence/machine.h"
+
+namespace crease::fold {
+
+class FoldSequencePlugin final : public Plugin {
+ public:
+  void configure(const Params& p, PortBinder& ports) override;
+  void activate() override;
+  Status update(const Cycle& c) override;
+  std::size_t save_state(std::span<std::byte> out) const noexcept override;
+  bool load_state(std::span<const std::byte> in) noexcept override;
+  std::string validate_param(std::string_view key, double value) override;
+
+  [[nodiscard]] const Machine& machine() const noexcept { return *machine_; }
+  [[nodiscard]] const FoldSpec& spec() const noexcept { return spec_; }
+
+ private:
+  FoldSpec spec_;
+  std::unique_ptr<Machine> machine_;
+  std::unique_ptr<Outbox> outbox_;
+  bool auto_start_ = false;
+  bool started_ = false;
+  double command_ = 0;  // the tunable: a Command, 0 when none is waiting
+  std::uint32_t logged_transitions_ = 0;
+  LatestInput<ArmMotionStatus> arm_status_[2];
+  LatestInput<HandControlStatus> hand_status_[2];
+  LatestInput<ContactState> contact_[2];
+  LatestInput<SheetState> sheet_;
+  QueueOutput<ArmGoal> arm_goal_[2];
+  QueueOutput<HandGoal> hand_goal_[2];
+  QueueOutput<SheetCreaseEvent> crease_;
+  QueueOutput<SheetMemorizeEvent> memorize_;
+  LatestOutput<SequenceStatus> status_;
+  SequenceStatus status_value_{};
+};
+
+}  // namespace crease::fold

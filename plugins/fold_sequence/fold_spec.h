@@ -1,0 +1,118 @@
+// A fold as data: what one sequence file (config/folds/*.yaml) says about a fold of seed 000
+// Fig. 7, steps (a)-(h): where each hand touches the sheet, the via points of the bend, the
+// forces, the motions' limits, the sensing bounds, the timeouts and the fold line.
+//
+// Points of the sheet are in arm_motion's sheet frame (ArmGoal::sheet): origin at node (0, 0),
+// x along u, y along v, z = u x v into the paper; a sheet lying printed face up has z pointing
+// into the table, so a height h mm above the sheet is z = -h. Files give (u, v) in mm and heights
+// in mm above the sheet (`[u, v, h]`); FoldSpec stores sheet-frame points (z = -h).
+// Parking poses are in the world frame (mm, z up). Forces N, durations s, speeds mm/s, rad/s.
+// Loaded at configure (non-RT); the machine reads it at run time without changing it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace crease::fold {
+
+inline constexpr int kMaxVia = 16;
+inline constexpr int kHandJoints = 20;
+inline constexpr int kStates = 64;  // at least the machine's state count (states.h checks it)
+
+// An arm motion's limits (ArmGoal's fields of the same names).
+struct MotionLimits {
+  float speed_mm_s = 50;
+  float accel_mm_s2 = 300;
+  float angular_speed_rad_s = 0.5f;
+  float angular_accel_rad_s2 = 3;
+  float stop_accel_mm_s2 = 2000;
+};
+
+// One hand landing on the sheet with C_contact and pressing with C_force: above `at` by
+// approach_height_mm, then down towards contact_depth_mm below the surface, stopped by a contact
+// onset of a finger in `fingers`, then force_n per finger in `fingers` (the thumb never).
+struct ContactStep {
+  std::uint8_t tool = 0;     // robot::ToolFrame (0..4 pads ff mf rf lf th, 5..9 backs)
+  std::uint8_t fingers = 1;  // bit f: finger f (ff mf rf lf th)
+  double at_mm[2] = {0, 0};  // (u, v) on the sheet
+  double approach_height_mm = 30;
+  double contact_depth_mm = 5;
+  double force_n = 1;
+  double orientation[4] = {0, 0, 0, 1};  // the tool frame in the sheet frame, quaternion x y z w
+};
+
+struct FoldSpec {
+  std::string name;     // e.g. "half"
+  std::string file;     // where it was read from
+  double fold_line_mm[2][2] = {};  // the crease the fold intends: (u0, v0), (u1, v1), sheet mm
+
+  // Sensing bounds.
+  double vision_lost_max_s = 0.5;   // sheet_state stale, or fewer than min_observations, this long: abort
+  std::uint32_t min_observations = 1;
+  double sheet_max_age_s = 0.2;     // a sheet_state older than this is not the current sheet
+  double status_max_age_s = 0.05;   // a controller's status older than this: device fault
+
+  // Every state's timeout (s), by state id; default `timeout_s`, per state `timeouts_s`.
+  std::array<double, kStates> timeout_s{};
+
+  MotionLimits approach, contact, slide, fold, retreat;
+
+  // Hand postures (20 joints, drivers/README.md's order, rad) and their ramp.
+  float open_rad[kHandJoints] = {};
+  float pinch_rad[kHandJoints] = {};
+  double posture_ramp_s = 0.3;
+  double force_ramp_s = 0.1;       // a force goal's target ramp
+
+  // (a) shift: the right hand presses at shift.at, then slides the sheet so that `corner_mm`
+  // (u, v) moves to `corner_target_mm` (world x, y): the slide's vector from the tracked pose.
+  ContactStep shift;
+  double corner_mm[2] = {0, 0};
+  double corner_target_mm[2] = {0, 0};
+  double shift_tolerance_mm = 3;   // no slide when the corner is this close already
+  double max_slide_mm = 150;       // a longer slide aborts (reason slide_out_of_range)
+  double slide_height_mm = 0;      // the tool frame's height above the sheet while sliding
+
+  // (b) grasp: the right hand fixates with fixate_force_n; the left moves its tool to above_mm,
+  // then to at_mm, then closes to pinch_rad until contact_state shows pinch_fingers.
+  double fixate_force_n = 2;
+  std::uint8_t grasp_tool = 4;
+  std::uint8_t pinch_fingers = 0x11;  // th + ff
+  double grasp_above_mm[3] = {};   // sheet frame
+  double grasp_at_mm[3] = {};
+  double grasp_orientation[4] = {0, 0, 0, 1};
+
+  // (c) bend: the left tool through via points (sheet frame of the sheet at each one's start).
+  int via_count = 0;
+  double via_mm[kMaxVia][3] = {};
+  double via_orientation[kMaxVia][4] = {};
+
+  // (d) the left hand's finger backs on the bent layer; (e) the right hand on both layers.
+  ContactStep fixate_layer;
+  ContactStep refixate;
+  double release_lift_mm = 30;     // a hand lifts this far after it opened (e, f, g)
+
+  // (f) the coarse swipe: the left hand lands at swipe.at and slides to swipe_to_mm (u, v).
+  ContactStep swipe;
+  double swipe_to_mm[2] = {0, 0};
+
+  // (g) hardening: two fingers along the model's crease line, inset from its ends, offset
+  // across it (towards +v of the line's normal), landing as `harden` says (its at_mm unused).
+  ContactStep harden;
+  double harden_inset_mm = 10;
+  double harden_offset_mm = 0;
+
+  // (h) and the abort's retreat: lift, then park (world frame mm, quaternion x y z w).
+  double park_mm[2][3] = {};       // [right, left]
+  double park_orientation[2][4] = {{0, 0, 0, 1}, {0, 0, 0, 1}};
+};
+
+// Reads a sequence file. Throws ConfigError "FILE:LINE:COLUMN: fold.KEY: reason" for a file that
+// cannot be read or parsed, a missing, mistyped, out-of-range or unknown key.
+[[nodiscard]] FoldSpec load_fold_file(const std::string& path);
+
+// The tool frame and finger names files use: "ff_pad", "th_back", "palm_front", "flange"; "ff"...
+[[nodiscard]] int tool_index(const std::string& name);    // -1 when unknown
+[[nodiscard]] int finger_index(const std::string& name);  // -1 when unknown
+
+}  // namespace crease::fold

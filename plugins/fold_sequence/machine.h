@@ -1,0 +1,155 @@
+// The folding sequence's machine: runs the tables of states.h against one cycle's sensing and
+// emits the commands of the states it enters. A hierarchical state machine: entering a state
+// enters its superstates from the common ancestor down and its initial children, leaving one
+// runs the exit actions from the leaf up; a transition is one row of states.h, at most one per
+// cycle. Its whole run-time state is `Memory`, one plain struct (copied whole at a hot-swap).
+//
+// Each cycle (RT, no allocation): the operator's command, if any, then the fault checks (in
+// `fold`), then the rows of the active states from the innermost outwards. A paused machine
+// checks faults but fires no other row and counts no time; in step mode it pauses before each
+// transition other than an abort (`step` makes that one transition, `resume` goes on). Pausing
+// by the operator stops the arms and holds the hands that press; resuming re-enters the state
+// (its commands sent again from where the robot is).
+//
+// Which hand does what is seed 000's (Fig. 7): the right hand (taxels) presses and fixates, the
+// left (PST) pinches, bends, swipes and hardens. Index 0 is the right side, 1 the left.
+#pragma once
+
+#include <cstdint>
+
+#include "core/port_types/arm_goal.h"
+#include "core/port_types/contact.h"
+#include "core/port_types/hand_control.h"
+#include "core/port_types/hand_goal.h"
+#include "core/port_types/sequence_status.h"
+#include "core/port_types/sheet_state.h"
+#include "plugins/fold_sequence/fold_spec.h"
+#include "plugins/fold_sequence/states.h"
+
+namespace crease::fold {
+
+inline constexpr int kRight = 0;
+inline constexpr int kLeft = 1;
+
+// One cycle's sensing; a null pointer: never written. Timestamps are compared with now_ns.
+struct Sensing {
+  std::int64_t now_ns = 0;
+  const ArmMotionStatus* arm[2] = {nullptr, nullptr};
+  const HandControlStatus* hand[2] = {nullptr, nullptr};
+  const ContactState* contact[2] = {nullptr, nullptr};
+  const SheetState* sheet = nullptr;
+};
+
+// What one cycle sends, in order per port (the plugin pushes them onto its queues).
+struct Outbox {
+  static constexpr int kPerPort = 2;
+  ArmGoal arm[2][kPerPort];
+  int arm_count[2] = {0, 0};
+  HandGoal hand[2][kPerPort];
+  int hand_count[2] = {0, 0};
+  SheetCreaseEvent crease;
+  bool has_crease = false;
+  SheetMemorizeEvent memorize;
+  bool has_memorize = false;
+  bool overflow = false;  // a state sent more than kPerPort to one port (a bug of the tables)
+  void clear() noexcept {
+    arm_count[0] = arm_count[1] = hand_count[0] = hand_count[1] = 0;
+    has_crease = has_memorize = overflow = false;
+  }
+};
+
+enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, abort = 4, step = 5 };
+
+struct Memory {
+  static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
+  static constexpr std::uint32_t kVersion = 1;
+  std::uint32_t tag = kTag;
+  std::uint32_t version = kVersion;
+  std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
+  S leaf = S::idle;
+  std::uint8_t via = 0;
+  std::uint8_t paused = 0;          // by the operator (arms stopped): resume re-enters the leaf
+  std::uint8_t step_mode = 0;
+  std::uint8_t start_pending = 0;
+  std::uint8_t self_entry = 0;      // the entry running is a self-transition's
+  Reason last_reason = Reason::none;
+  Reason abort_reason = Reason::none;
+  std::int16_t last_row = -1;       // index into all_rows() of the last transition; -1 none
+  std::int16_t gate_row = -1;       // step mode: the transition held until `step`
+  std::uint32_t transitions = 0;
+  std::uint32_t aborts = 0;
+  std::int64_t last_ns = 0;         // the previous cycle's time
+  std::int64_t leaf_since_ns = 0;
+  std::int64_t elapsed_ns[kStateCount] = {};  // time in each active state, pauses not counted
+  std::int64_t vision_bad_since_ns = 0;       // 0: the sheet is seen
+  std::uint32_t next_id = 1;
+  std::uint32_t arm_id[2] = {0, 0};   // this state's arm goals (0: none)
+  std::uint32_t hand_id[2] = {0, 0};  // this state's hand goals
+  std::uint64_t hand_refused0[2] = {0, 0};  // goals_refused when that hand goal was sent
+  HandMode hand_mode[2] = {HandMode::hold, HandMode::hold};  // the mode last asked of each hand
+  std::uint8_t arm_has_target[2] = {0, 0};
+  std::uint8_t arm_frame[2] = {0, 0};
+  std::uint8_t arm_tool[2] = {0, 0};
+  double arm_target[2][3] = {};       // the last move goal's target (its frame)
+  double arm_orientation[2][4] = {};
+  std::uint32_t crease_count0 = 0;    // sheet_state's creases when the crease was sent
+  std::uint64_t sheet_step0 = 0;      // sheet_state's step when the memorize was sent
+  double harden_a[2] = {}, harden_b[2] = {};  // the hardening stroke (sheet mm), from the model
+};
+
+class Machine {
+ public:
+  explicit Machine(const FoldSpec& spec) noexcept;
+
+  // RT. Takes the operator's command (applied in the next step()).
+  void command(Command c) noexcept { command_ = c; }
+  // RT. One cycle: commands, faults, rows; the entered states' commands into out (cleared first).
+  void step(const Sensing& in, Outbox& out) noexcept;
+  // RT. A fault found outside the machine (a full command queue): abort with `r` when folding.
+  void fail(Reason r) noexcept { external_fault_ = r; }
+
+  [[nodiscard]] const Memory& memory() const noexcept { return m_; }
+  // False (and nothing changed) when `saved` is not a memory of this fold and version.
+  [[nodiscard]] bool restore(const Memory& saved) noexcept;
+  // RT. The status port's value now.
+  void fill_status(SequenceStatus& s, std::int64_t now_ns) const noexcept;
+  [[nodiscard]] SequenceStatus::Phase phase() const noexcept;
+
+ private:
+  // machine.cpp: the engine.
+  void apply_command(const Sensing& in, Outbox& out) noexcept;
+  void go(S to, Reason r, int row, const Sensing& in, Outbox& out) noexcept;
+  void count_time(std::int64_t now_ns) noexcept;
+  [[nodiscard]] bool timed_out(S owner) const noexcept;
+  // conditions.cpp: events, guards, faults.
+  [[nodiscard]] bool holds(Ev ev, S owner, const Sensing& in) const noexcept;
+  [[nodiscard]] bool passes(Guard g, const Sensing& in) const noexcept;
+  [[nodiscard]] Reason fault(const Sensing& in) noexcept;  // Reason::none when all is well
+  [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2]) const noexcept;
+  // actions.cpp: entry and exit actions, the goals.
+  void enter(S s, const Sensing& in, Outbox& out) noexcept;
+  void exit(S s, const Sensing& in, Outbox& out) noexcept;
+  void stop_for_pause(Outbox& out) noexcept;
+  void arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
+                const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;  // 0: no stop
+  void arm_stop(int side, Outbox& out) noexcept;
+  void arm_lift(int side, double lift_mm, Outbox& out) noexcept;
+  void arm_park(int side, Outbox& out) noexcept;
+  void hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out) noexcept;
+  void hand_force(int side, std::uint8_t fingers, double force_n, const Sensing& in, Outbox& out) noexcept;
+  void hand_hold(int side, const Sensing& in, Outbox& out) noexcept;
+  void approach(int side, const ContactStep& c, Outbox& out) noexcept;     // above c.at
+  void descend(int side, const ContactStep& c, Outbox& out) noexcept;      // down to c.at, stop on contact
+  void push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) noexcept;
+
+  const FoldSpec& spec_;
+  Memory m_;
+  Command command_ = Command::none;
+  Reason external_fault_ = Reason::none;
+  Reason detected_ = Reason::none;  // the fault found this cycle (the fault row's reason)
+};
+
+// A hash of what a Memory depends on in the fold (its name, via points), for load_state.
+[[nodiscard]] std::uint64_t spec_hash(const FoldSpec& f) noexcept;
+
+}  // namespace crease::fold

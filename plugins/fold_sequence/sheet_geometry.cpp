@@ -1,0 +1,82 @@
+#include "plugins/fold_sequence/sheet_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace crease::fold {
+namespace {
+
+bool node(const SheetState& s, int i, int j, double out[3]) noexcept {
+  const float* p = s.position_mm[static_cast<std::size_t>(j) * s.nodes_u + static_cast<std::size_t>(i)];
+  for (int c = 0; c < 3; ++c) {
+    out[c] = p[c];
+    if (!std::isfinite(out[c])) return false;
+  }
+  return true;
+}
+
+bool usable(const SheetState& s) noexcept {
+  return s.nodes_u >= 2 && s.nodes_v >= 2 &&
+         static_cast<std::uint32_t>(s.nodes_u) * s.nodes_v <= SheetState::kMaxNodes && s.width_mm > 0 &&
+         s.height_mm > 0;
+}
+
+double norm(const double v[3]) noexcept { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+}  // namespace
+
+bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept {
+  if (!usable(s)) return false;
+  double o[3], a[3], b[3];
+  if (!node(s, 0, 0, o) || !node(s, s.nodes_u - 1, 0, a) || !node(s, 0, s.nodes_v - 1, b)) return false;
+  double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+  const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+  const double nu = norm(u);
+  if (nu < 1e-6) return false;
+  for (double& c : u) c /= nu;
+  double z[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double nz = norm(z);
+  if (nz < 1e-6) return false;
+  for (double& c : z) c /= nz;
+  for (int c = 0; c < 3; ++c) {
+    f.origin[c] = o[c];
+    f.x[c] = u[c];
+    f.z[c] = z[c];
+  }
+  f.y[0] = z[1] * u[2] - z[2] * u[1];
+  f.y[1] = z[2] * u[0] - z[0] * u[2];
+  f.y[2] = z[0] * u[1] - z[1] * u[0];
+  return true;
+}
+
+bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept {
+  if (!usable(s) || !std::isfinite(u) || !std::isfinite(v)) return false;
+  const int i = std::clamp(static_cast<int>(std::lround(u / s.width_mm * (s.nodes_u - 1))), 0, s.nodes_u - 1);
+  const int j = std::clamp(static_cast<int>(std::lround(v / s.height_mm * (s.nodes_v - 1))), 0, s.nodes_v - 1);
+  return node(s, i, j, out);
+}
+
+bool nearest_crease(const SheetState& s, double a[2], double b[2]) noexcept {
+  const std::uint32_t n = std::min(s.crease_count, SheetState::kMaxCreases);
+  double best = 1e300;
+  double ba[2] = {0, 0}, bb[2] = {0, 0};
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const float* c = s.crease_mm[k];
+    const double same = std::hypot(c[0] - a[0], c[1] - a[1]) + std::hypot(c[2] - b[0], c[3] - b[1]);
+    const double flip = std::hypot(c[2] - a[0], c[3] - a[1]) + std::hypot(c[0] - b[0], c[1] - b[1]);
+    if (!std::isfinite(same) || !std::isfinite(flip)) continue;
+    if (same < best) {
+      best = same;
+      ba[0] = c[0], ba[1] = c[1], bb[0] = c[2], bb[1] = c[3];
+    }
+    if (flip < best) {
+      best = flip;
+      ba[0] = c[2], ba[1] = c[3], bb[0] = c[0], bb[1] = c[1];
+    }
+  }
+  if (best == 1e300) return false;
+  a[0] = ba[0], a[1] = ba[1], b[0] = bb[0], b[1] = bb[1];
+  return true;
+}
+
+}  // namespace crease::fold

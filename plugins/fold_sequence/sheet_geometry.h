@@ -1,0 +1,24 @@
+// What the sequence reads of the tracked sheet (sheet_state, the model's estimate, never the
+// world's truth): the sheet frame arm_motion resolves sheet-frame goals in (origin node (0, 0),
+// x along u, z = u x v, y = z x x; plugins/arm_motion/sheet_frame.h), a node's world position
+// by its sheet coordinates, and the crease nearest to a line. World mm. RT: reads a few nodes.
+#pragma once
+
+#include "core/port_types/sheet_state.h"
+
+namespace crease::fold {
+
+struct SheetFrame {
+  double origin[3];
+  double x[3], y[3], z[3];  // unit axes in the world
+};
+
+// False for a state with fewer than 2 x 2 nodes, non-finite corners or degenerate edges.
+[[nodiscard]] bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept;
+// The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
+[[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
+// The crease of s nearest to the segment a-b (sheet mm, by the sum of its end points'
+// distances, either direction), into a, b (oriented like the given one). False when s has none.
+[[nodiscard]] bool nearest_crease(const SheetState& s, double a[2], double b[2]) noexcept;
+
+}  // namespace crease::fold

@@ -1,0 +1,230 @@
+#include "plugins/fold_sequence/states.h"
+
+#include <array>
+#include <cstring>
+
+namespace crease::fold {
+namespace {
+
+constexpr std::array<StateInfo, kStateCount> kStatesTable = {{
+    {S::root, S::root, S::idle, ""},
+    {S::idle, S::root, S::idle, "idle"},
+    {S::fold, S::root, S::shift, "fold"},
+    {S::shift, S::fold, S::shift_approach, "shift"},
+    {S::shift_approach, S::shift, S::shift_approach, "approach"},
+    {S::shift_contact, S::shift, S::shift_contact, "contact"},
+    {S::shift_press, S::shift, S::shift_press, "press"},
+    {S::shift_slide, S::shift, S::shift_slide, "slide"},
+    {S::grasp, S::fold, S::grasp_fixate, "grasp"},
+    {S::grasp_fixate, S::grasp, S::grasp_fixate, "fixate"},
+    {S::grasp_above, S::grasp, S::grasp_above, "above"},
+    {S::grasp_reach, S::grasp, S::grasp_reach, "reach"},
+    {S::grasp_pinch, S::grasp, S::grasp_pinch, "pinch"},
+    {S::bend, S::fold, S::bend_crease, "bend"},
+    {S::bend_crease, S::bend, S::bend_crease, "crease"},
+    {S::follow_via, S::bend, S::follow_via, "follow_via"},
+    {S::fixate_layer, S::fold, S::layer_approach, "fixate_layer"},
+    {S::layer_approach, S::fixate_layer, S::layer_approach, "approach"},
+    {S::layer_contact, S::fixate_layer, S::layer_contact, "contact"},
+    {S::layer_press, S::fixate_layer, S::layer_press, "press"},
+    {S::refixate, S::fold, S::refix_open, "refixate"},
+    {S::refix_open, S::refixate, S::refix_open, "open"},
+    {S::refix_lift, S::refixate, S::refix_lift, "lift"},
+    {S::refix_approach, S::refixate, S::refix_approach, "approach"},
+    {S::refix_contact, S::refixate, S::refix_contact, "contact"},
+    {S::refix_press, S::refixate, S::refix_press, "press"},
+    {S::swipe, S::fold, S::swipe_open, "swipe"},
+    {S::swipe_open, S::swipe, S::swipe_open, "open"},
+    {S::swipe_lift, S::swipe, S::swipe_lift, "lift"},
+    {S::swipe_approach, S::swipe, S::swipe_approach, "approach"},
+    {S::swipe_contact, S::swipe, S::swipe_contact, "contact"},
+    {S::swipe_press, S::swipe, S::swipe_press, "press"},
+    {S::swipe_slide, S::swipe, S::swipe_slide, "slide"},
+    {S::harden, S::fold, S::harden_open, "harden"},
+    {S::harden_open, S::harden, S::harden_open, "open"},
+    {S::harden_lift, S::harden, S::harden_lift, "lift"},
+    {S::harden_approach, S::harden, S::harden_approach, "approach"},
+    {S::harden_contact, S::harden, S::harden_contact, "contact"},
+    {S::harden_press, S::harden, S::harden_press, "press"},
+    {S::harden_slide, S::harden, S::harden_slide, "slide"},
+    {S::finish, S::fold, S::finish_memorize, "finish"},
+    {S::finish_memorize, S::finish, S::finish_memorize, "memorize"},
+    {S::finish_open, S::finish, S::finish_open, "open"},
+    {S::finish_lift, S::finish, S::finish_lift, "lift"},
+    {S::finish_park, S::finish, S::finish_park, "park"},
+    {S::done, S::root, S::done, "done"},
+    {S::abort, S::root, S::abort_stop, "abort"},
+    {S::abort_stop, S::abort, S::abort_stop, "stop"},
+    {S::abort_open, S::abort, S::abort_open, "open"},
+    {S::abort_lift, S::abort, S::abort_lift, "lift"},
+    {S::abort_park, S::abort, S::abort_park, "park"},
+    {S::aborted, S::root, S::aborted, "aborted"},
+}};
+
+constexpr bool table_in_order() {
+  for (int i = 0; i < kStateCount; ++i)
+    if (static_cast<int>(kStatesTable[static_cast<std::size_t>(i)].id) != i) return false;
+  return true;
+}
+static_assert(table_in_order(), "kStatesTable lists the states in S's order");
+
+constexpr Reason C = Reason::condition;
+
+// Rows by state, in S's order (rows_of relies on it). The first row whose event holds and whose
+// guard passes fires; a state's rows come before its superstates'.
+constexpr Row kRows[] = {
+    {S::idle, Ev::start, Guard::none, S::fold, Reason::started, "start"},
+
+    {S::fold, Ev::fault, Guard::none, S::abort, Reason::device_fault, "fault"},  // reason: the detector's
+    {S::fold, Ev::timeout, Guard::none, S::abort, Reason::timeout, "state timeout"},
+
+    {S::shift_approach, Ev::arm_r_reached, Guard::right_armed, S::shift_contact, C, "right tool above the press point"},
+    {S::shift_contact, Ev::arm_r_contact, Guard::none, S::shift_press, C, "right hand touches the sheet"},
+    {S::shift_press, Ev::hand_r_settled, Guard::slide_too_long, S::abort, Reason::slide_out_of_range,
+     "slide longer than max_slide_mm"},
+    {S::shift_press, Ev::hand_r_settled, Guard::slide_needed, S::shift_slide, C, "right force settled"},
+    {S::shift_press, Ev::hand_r_settled, Guard::slide_short, S::grasp, C, "corner already in reach"},
+    {S::shift_slide, Ev::arm_r_reached, Guard::none, S::grasp, C, "sheet shifted"},
+
+    {S::grasp_fixate, Ev::hand_r_settled, Guard::none, S::grasp_above, C, "right hand fixates"},
+    {S::grasp_above, Ev::arm_l_reached, Guard::none, S::grasp_reach, C, "left tool above the corner"},
+    {S::grasp_reach, Ev::arm_l_reached, Guard::none, S::grasp_pinch, C, "left tool at the corner"},
+    {S::grasp_pinch, Ev::pinched, Guard::none, S::bend, C, "corner pinched"},
+
+    {S::bend_crease, Ev::crease_acked, Guard::none, S::follow_via, C, "model has the crease"},
+    {S::follow_via, Ev::arm_l_reached, Guard::more_via, S::follow_via, C, "via point reached"},
+    {S::follow_via, Ev::arm_l_reached, Guard::last_via, S::fixate_layer, C, "last via point reached"},
+
+    {S::layer_approach, Ev::arm_l_reached, Guard::left_armed, S::layer_contact, C, "left tool above the layer"},
+    {S::layer_contact, Ev::arm_l_contact, Guard::none, S::layer_press, C, "finger backs touch the layer"},
+    {S::layer_press, Ev::hand_l_settled, Guard::none, S::refixate, C, "layer fixated"},
+
+    {S::refix_open, Ev::hand_r_posed, Guard::none, S::refix_lift, C, "right hand open"},
+    {S::refix_lift, Ev::arm_r_reached, Guard::none, S::refix_approach, C, "right hand lifted"},
+    {S::refix_approach, Ev::arm_r_reached, Guard::right_armed, S::refix_contact, C, "right tool above both layers"},
+    {S::refix_contact, Ev::arm_r_contact, Guard::none, S::refix_press, C, "right hand touches both layers"},
+    {S::refix_press, Ev::hand_r_settled, Guard::none, S::swipe, C, "both layers fixated"},
+
+    {S::swipe_open, Ev::hand_l_posed, Guard::none, S::swipe_lift, C, "left hand open"},
+    {S::swipe_lift, Ev::arm_l_reached, Guard::none, S::swipe_approach, C, "left hand lifted"},
+    {S::swipe_approach, Ev::arm_l_reached, Guard::left_armed, S::swipe_contact, C, "left tool above the swipe"},
+    {S::swipe_contact, Ev::arm_l_contact, Guard::none, S::swipe_press, C, "left hand touches the fold"},
+    {S::swipe_press, Ev::hand_l_settled, Guard::none, S::swipe_slide, C, "swipe force settled"},
+    {S::swipe_slide, Ev::arm_l_reached, Guard::none, S::harden, C, "swiped"},
+
+    {S::harden_open, Ev::hand_l_posed, Guard::none, S::harden_lift, C, "left hand open"},
+    {S::harden_lift, Ev::arm_l_reached, Guard::none, S::harden_approach, C, "left hand lifted"},
+    {S::harden_approach, Ev::arm_l_reached, Guard::left_armed, S::harden_contact, C, "left tool above the crease"},
+    {S::harden_contact, Ev::arm_l_contact, Guard::none, S::harden_press, C, "two fingers on the crease"},
+    {S::harden_press, Ev::hand_l_settled, Guard::none, S::harden_slide, C, "hardening force settled"},
+    {S::harden_slide, Ev::arm_l_reached, Guard::none, S::finish, C, "crease hardened"},
+
+    {S::finish_memorize, Ev::memorized, Guard::none, S::finish_open, C, "model memorized the fold"},
+    {S::finish_open, Ev::hands_posed, Guard::none, S::finish_lift, C, "hands open"},
+    {S::finish_lift, Ev::arms_reached, Guard::none, S::finish_park, C, "hands lifted"},
+    {S::finish_park, Ev::arms_reached, Guard::none, S::done, C, "arms parked"},
+
+    {S::done, Ev::start, Guard::none, S::fold, Reason::started, "start"},
+
+    {S::abort, Ev::timeout, Guard::none, S::aborted, Reason::timeout, "abort timed out"},
+    {S::abort_stop, Ev::stopped, Guard::none, S::abort_open, C, "force stopped, arms still"},
+    {S::abort_stop, Ev::timeout, Guard::none, S::abort_open, Reason::timeout, "stop timed out"},
+    {S::abort_open, Ev::hands_posed, Guard::none, S::abort_lift, C, "hands open"},
+    {S::abort_open, Ev::timeout, Guard::none, S::abort_lift, Reason::timeout, "open timed out"},
+    {S::abort_lift, Ev::arms_done, Guard::none, S::abort_park, C, "lift ended"},
+    {S::abort_lift, Ev::timeout, Guard::none, S::abort_park, Reason::timeout, "lift timed out"},
+    {S::abort_park, Ev::arms_done, Guard::none, S::aborted, C, "park ended"},
+    {S::abort_park, Ev::timeout, Guard::none, S::aborted, Reason::timeout, "park timed out"},
+
+    {S::aborted, Ev::start, Guard::none, S::fold, Reason::started, "start"},
+};
+constexpr int kRowCount = static_cast<int>(sizeof(kRows) / sizeof(kRows[0]));
+
+constexpr bool rows_in_order() {
+  for (int i = 1; i < kRowCount; ++i)
+    if (kRows[i].from < kRows[i - 1].from) return false;
+  return true;
+}
+static_assert(rows_in_order(), "kRows are grouped by state in S's order");
+
+constexpr const char* kReasonNames[] = {
+    "none",        "started",      "condition",      "timeout",        "device_fault",
+    "vision_lost", "force_limit",  "unreachable",    "goal_refused",   "motion_aborted",
+    "slide_out_of_range", "no_sheet", "command_lost", "operator_abort",
+};
+static_assert(sizeof(kReasonNames) / sizeof(kReasonNames[0]) == static_cast<std::size_t>(Reason::count));
+
+}  // namespace
+
+const char* reason_name(Reason r) noexcept {
+  const auto i = static_cast<std::size_t>(r);
+  return i < static_cast<std::size_t>(Reason::count) ? kReasonNames[i] : "?";
+}
+
+const StateInfo& state_info(S s) noexcept { return kStatesTable[static_cast<std::size_t>(s)]; }
+
+int depth(S s) noexcept {
+  int d = 0;
+  while (s != S::root) {
+    s = state_info(s).parent;
+    ++d;
+  }
+  return d;
+}
+
+bool is_within(S s, S ancestor) noexcept {
+  for (;;) {
+    if (s == ancestor) return true;
+    if (s == S::root) return false;
+    s = state_info(s).parent;
+  }
+}
+
+RowSpan all_rows() noexcept { return {kRows, kRows + kRowCount}; }
+
+RowSpan rows_of(S s) noexcept {
+  const Row* b = kRows;
+  while (b != kRows + kRowCount && b->from < s) ++b;
+  const Row* e = b;
+  while (e != kRows + kRowCount && e->from == s) ++e;
+  return {b, e};
+}
+
+S state_by_path(std::string_view path) noexcept {
+  for (int i = 1; i < kStateCount; ++i) {
+    char buf[96];
+    write_path(static_cast<S>(i), -1, buf, sizeof buf);
+    if (path == buf) return static_cast<S>(i);
+  }
+  return S::count;
+}
+
+void write_path(S s, int via, char* out, std::size_t n) noexcept {
+  if (n == 0) return;
+  S chain[8];
+  int k = 0;
+  for (S x = s; x != S::root && k < 8; x = state_info(x).parent) chain[k++] = x;
+  std::size_t at = 0;
+  auto put = [&](const char* t) {
+    while (*t != '\0' && at + 1 < n) out[at++] = *t++;
+  };
+  for (int i = k - 1; i >= 0; --i) {
+    put(state_info(chain[i]).name);
+    if (i > 0) put("/");
+  }
+  if (s == S::follow_via && via >= 0) {
+    char digits[8];
+    int d = 0;
+    unsigned v = static_cast<unsigned>(via);
+    do {
+      digits[d++] = static_cast<char>('0' + v % 10);
+      v /= 10;
+    } while (v != 0 && d < 7);
+    put("[");
+    while (d > 0 && at + 1 < n) out[at++] = digits[--d];
+    put("]");
+  }
+  out[at] = '\0';
+}
+
+}  // namespace crease::fold
