@@ -1,4 +1,5 @@
 #include "core/daemon/views.h"
+#include "core/daemon/sequences.h"
 #include "core/report/report_json.h"
 
 namespace crease::daemon {
@@ -22,6 +23,8 @@ nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::i
                     {"busy", c.busy},
                     {"refused", c.malformed + c.unknown_command + c.bad_argument}};
   }
+  nlohmann::json sequences = sequences_view(host.ports());  // folding sequences, when any runs
+  if (!sequences.empty()) s["sequences"] = std::move(sequences);
   return s;
 }
 

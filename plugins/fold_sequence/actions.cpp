@@ -102,6 +102,8 @@ void Machine::hand_force(int side, std::uint8_t fingers, double force_n, const S
   g.fingers = static_cast<std::uint8_t>(fingers & 0x0f);  // the thumb never presses
   g.force_n = static_cast<float>(force_n);
   g.ramp_s = static_cast<float>(spec_.force_ramp_s);
+  m_.force_fingers[side] = g.fingers;
+  m_.force_n[side] = g.force_n;
   push_hand(side, g, in, out);
 }
 
@@ -128,8 +130,10 @@ void Machine::stop_for_pause(Outbox& out) noexcept {
   }
   // Hands that press keep their targets (hold); the others keep their posture as it is.
   const Sensing none{};
-  for (int s = 0; s < 2; ++s)
-    if (m_.hand_mode[s] == HandMode::force) hand_hold(s, none, out);
+  for (int s = 0; s < 2; ++s) {
+    m_.held_by_pause[s] = m_.hand_mode[s] == HandMode::force ? 1 : 0;
+    if (m_.held_by_pause[s]) hand_hold(s, none, out);
+  }
   for (int s = 0; s < 2; ++s) m_.hand_id[s] = 0;
 }
 

@@ -154,6 +154,11 @@ void Machine::apply_command(const Sensing& in, Outbox& out) noexcept {
         exit(m_.leaf, in, out);
         m_.self_entry = 0;
         enter(m_.leaf, in, out);  // the state's commands again, from where the robot stopped
+        for (int s = 0; s < 2; ++s) {  // and the hands the pause held press again (unless the state sent them a goal)
+          if (m_.held_by_pause[s] && out.hand_count[s] == 0)
+            hand_force(s, m_.force_fingers[s], m_.force_n[s], in, out);
+          m_.held_by_pause[s] = 0;
+        }
       } else if (!folding && c == Command::step && !is_within(m_.leaf, S::abort)) {
         m_.start_pending = 1;  // step from idle: start, pausing before the first transition
       }

@@ -87,6 +87,9 @@ struct Memory {
   std::uint32_t hand_id[2] = {0, 0};  // this state's hand goals
   std::uint64_t hand_refused0[2] = {0, 0};  // goals_refused when that hand goal was sent
   HandMode hand_mode[2] = {HandMode::hold, HandMode::hold};  // the mode last asked of each hand
+  std::uint8_t force_fingers[2] = {0, 0};  // the last force goal of each hand, for a resume
+  float force_n[2] = {0, 0};
+  std::uint8_t held_by_pause[2] = {0, 0};  // 1: the pause put this pressing hand on hold
   std::uint8_t arm_has_target[2] = {0, 0};
   std::uint8_t arm_frame[2] = {0, 0};
   std::uint8_t arm_tool[2] = {0, 0};

@@ -15,6 +15,7 @@
 #include "core/control/protocol.h"
 #include "core/control/socket_path.h"
 #include "tools/creasectl/human_format.h"
+#include "tools/creasectl/sequence_command.h"
 
 namespace {
 
@@ -164,6 +165,8 @@ int main(int argc, char** argv) {
     request = {{"cmd", "param"}, {"action", "set"}, {"instance", o.instance}, {"key", o.key},
                {"value", crease::ctl::parse_cli_value(o.value)}};
   });
+
+  crease::ctl::add_sequence_command(app, cmd, request);
 
   auto* report = app.add_subcommand("report", "timing report of the run so far");
   report->add_option("--format", o.format, "html, json or text")

@@ -126,6 +126,20 @@ TEST_CASE("creasectl talks to the control socket") {
   r = creasectl(sock + "param get counter step");
   CHECK(daemon.last_request() ==
         json{{"cmd", "param"}, {"id", 1}, {"action", "get"}, {"instance", "counter"}, {"key", "step"}});
+  // sequence: the fold_sequence instance's `command` tunable through param set.
+  r = creasectl(sock + "sequence pause");
+  CHECK(r.status == 0);
+  CHECK(daemon.last_request() == json{{"cmd", "param"}, {"id", 1}, {"action", "set"}, {"instance", "fold"},
+                                      {"key", "command"}, {"value", 2}});
+  int code = 1;
+  for (const char* w : {"start", "pause", "resume", "abort", "step"}) {
+    r = creasectl(sock + "sequence " + w + " --instance fold2");
+    CHECK(r.status == 0);
+    CHECK(daemon.last_request()["instance"] == "fold2");
+    CHECK(daemon.last_request()["value"] == code++);
+  }
+  r = creasectl(sock + "sequence jump");
+  CHECK(r.status == 2);
   for (const char* c : {"unload", "activate", "deactivate"}) {
     r = creasectl(sock + c + " counter");
     CHECK(r.status == 0);

@@ -1,0 +1,379 @@
+// The fold_sequence plugin driven on its ports by a scripted robot (sequence_rig.h): a whole
+// half fold (the state path, the goals it sends and their content), the diagonal fold from its
+// file alone, success only from sensing, every fault reason ending in the retreat with the
+// hands open, the operator's commands, a hot-swap resuming in the same state, and no
+// allocation on the update path.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "sequence_rig.h"
+
+using namespace rig;
+using crease::fold::Command;
+using crease::fold::kLeft;
+using crease::fold::kRight;
+
+namespace {
+
+const std::vector<std::string> kHalfPath = {
+    "idle",
+    "fold/shift/approach", "fold/shift/contact", "fold/shift/press", "fold/shift/slide",
+    "fold/grasp/fixate", "fold/grasp/above", "fold/grasp/reach", "fold/grasp/pinch",
+    "fold/bend/crease", "fold/bend/follow_via[0]", "fold/bend/follow_via[1]", "fold/bend/follow_via[2]",
+    "fold/bend/follow_via[3]", "fold/bend/follow_via[4]",
+    "fold/fixate_layer/approach", "fold/fixate_layer/contact", "fold/fixate_layer/press",
+    "fold/refixate/open", "fold/refixate/lift", "fold/refixate/approach", "fold/refixate/contact",
+    "fold/refixate/press",
+    "fold/swipe/open", "fold/swipe/lift", "fold/swipe/approach", "fold/swipe/contact", "fold/swipe/press",
+    "fold/swipe/slide",
+    "fold/harden/open", "fold/harden/lift", "fold/harden/approach", "fold/harden/contact", "fold/harden/press",
+    "fold/harden/slide",
+    "fold/finish/memorize", "fold/finish/open", "fold/finish/lift", "fold/finish/park",
+    "done"};
+
+const std::vector<std::string> kRetreat = {"abort/stop", "abort/open", "abort/lift", "abort/park", "aborted"};
+
+bool near(double a, double b, double tol = 1e-3) { return std::abs(a - b) <= tol; }
+
+// After an abort: both hands' last goal opens them (posture, the fold's open targets: zeros),
+// no force goal reached a hand after the abort began, both arms were stopped and parked.
+void check_retreat(const Rig& r, long abort_cycle) {
+  for (int s = 0; s < 2; ++s) {
+    CAPTURE(s);
+    const Sent* h = r.last(s, Sent::hand);
+    REQUIRE(h != nullptr);
+    CHECK(h->hand_goal.mode == HandMode::posture);
+    for (float t : h->hand_goal.target_rad) CHECK(t == 0.0f);
+    for (const Sent* x : r.all(s, Sent::hand, abort_cycle)) CHECK(x->hand_goal.mode != HandMode::force);
+    const auto arm = r.all(s, Sent::arm, abort_cycle);
+    REQUIRE(!arm.empty());
+    CHECK(arm.front()->arm_goal.kind == ArmGoal::stop);
+    CHECK(arm.back()->arm_goal.kind == ArmGoal::move);
+    CHECK(arm.back()->arm_goal.frame == ArmGoal::world);  // parked
+    CHECK(arm.back()->arm_goal.position_mm[0][2] == 300.0);
+  }
+  CHECK(r.status().phase == SequenceStatus::aborted);
+  CHECK(std::string(r.status().path) == "aborted");
+}
+
+// Runs a half fold until `path`, then returns the cycle.
+long start_and_run_to(Rig& r, const std::string& path) {
+  r.command(Command::start);
+  REQUIRE(r.run_to(path));
+  return r.cycles();
+}
+
+// The fault test's common part: a fault makes the fold abort with `reason`, through the retreat.
+void expect_abort(Rig& r, crease::fold::Reason reason) {
+  const long c0 = r.cycles();
+  REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }, 100000));
+  const long abort_cycle = r.cycles();
+  CHECK(r.status().abort_reason == static_cast<std::uint8_t>(reason));
+  REQUIRE(r.run_to("aborted", 100000));
+  CHECK(r.status().abort_reason == static_cast<std::uint8_t>(reason));
+  const auto& p = r.paths();
+  REQUIRE(p.size() >= kRetreat.size());
+  CHECK(std::vector<std::string>(p.end() - static_cast<long>(kRetreat.size()), p.end()) == kRetreat);
+  check_retreat(r, abort_cycle);
+  (void)c0;
+}
+
+}  // namespace
+
+TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the file says, no allocation") {
+  REQUIRE(crease::rt::alloc_hooks_installed());
+  Rig r;
+  r.run(50);
+  CHECK(std::string(r.status().path) == "idle");  // nothing happens before start
+  CHECK(r.sent().empty());
+  r.command(Command::start);
+  REQUIRE(r.run_to("done"));
+  CHECK(r.paths() == kHalfPath);
+  CHECK(r.status().phase == SequenceStatus::done);
+  CHECK(r.allocations() == 0);
+
+  const auto right = r.all(kRight, Sent::arm);
+  const auto left = r.all(kLeft, Sent::arm);
+  // No arm is sent on before its motion ended (the robot's motions take move_cycles): each
+  // state waited for its motion's status, not for a time of its own.
+  for (const auto* arm : {&right, &left})
+    for (std::size_t i = 1; i < arm->size(); ++i) CHECK((*arm)[i]->cycle - (*arm)[i - 1]->cycle >= r.move_cycles);
+  // (a) approach above the press point, the contact motion, the slide from the tracked pose.
+  REQUIRE(right.size() >= 3);
+  const ArmGoal& ap = right[0]->arm_goal;
+  CHECK(ap.frame == ArmGoal::sheet);
+  CHECK(ap.tool == 0);  // ff_pad
+  CHECK(ap.position_mm[0][0] == 150.0);
+  CHECK(ap.position_mm[0][1] == 90.0);
+  CHECK(ap.position_mm[0][2] == -30.0);  // 30 mm above the sheet: the sheet frame's z points down
+  CHECK(ap.stop_on == ArmGoal::stop_none);
+  const ArmGoal& ct = right[1]->arm_goal;
+  CHECK(ct.stop_on == ArmGoal::contact_onset);
+  CHECK(ct.stop_fingers == 0x03);  // ff, mf
+  CHECK(ct.position_mm[0][2] == 5.0);
+  // The corner (0, 297) lies at world (-105, -148.5); its target (-130, -195): a slide of
+  // (-25, -46.5) mm in the world, (-25, +46.5) along the sheet's u and v (v runs along -y).
+  const ArmGoal& sl = right[2]->arm_goal;
+  CHECK(near(sl.position_mm[0][0], 125.0));
+  CHECK(near(sl.position_mm[0][1], 136.5));
+  CHECK(sl.speed_mm_s == 30.0f);
+  // The press, then the fixation force.
+  const auto rh = r.all(kRight, Sent::hand);
+  REQUIRE(rh.size() >= 3);
+  CHECK(rh[1]->hand_goal.mode == HandMode::force);
+  CHECK(rh[1]->hand_goal.force_n == 1.5f);
+  CHECK(rh[1]->hand_goal.fingers == 0x03);
+  CHECK(rh[2]->hand_goal.force_n == 2.0f);
+  // (c) the crease the fold intends goes to the model before the first via point, once.
+  long crease_cycle = -1;
+  int creases = 0;
+  for (const Sent& s : r.sent())
+    if (s.kind == Sent::crease) {
+      ++creases;
+      crease_cycle = s.cycle;
+      CHECK(s.crease_event.op == SheetCreaseEvent::Op::add);
+      CHECK(s.crease_event.a_mm[0] == 0.0f);
+      CHECK(s.crease_event.a_mm[1] == 148.5f);
+      CHECK(s.crease_event.b_mm[0] == 210.0f);
+      CHECK(s.crease_event.b_mm[1] == 148.5f);
+    }
+  CHECK(creases == 1);
+  // The left arm: above the corner, at it, then the five via points in order, in the sheet frame.
+  REQUIRE(left.size() >= 7);
+  const double via[5][3] = {{-5, 257.0, -108.5}, {-5, 148.5, -153.5}, {-5, 40.0, -108.5}, {-5, 0.2, -39.7}, {-5, -4.9, -5.4}};
+  for (int k = 0; k < 5; ++k) {
+    CAPTURE(k);
+    const ArmGoal& g = left[2 + static_cast<std::size_t>(k)]->arm_goal;
+    CHECK(left[2 + static_cast<std::size_t>(k)]->cycle > crease_cycle);
+    CHECK(g.frame == ArmGoal::sheet);
+    for (int c = 0; c < 3; ++c) CHECK(near(g.position_mm[0][c], via[k][c]));
+    CHECK(g.speed_mm_s == 40.0f);
+  }
+  CHECK(near(left[3]->arm_goal.orientation[0][0], -0.70711));  // 90 deg about -u: the wrist turns
+  // (g) the hardening stroke along the model's crease, inset 10 mm, 4 mm onto the stack.
+  const Sent* hs = nullptr;
+  for (const Sent* s : left)
+    if (s->arm_goal.stop_on == ArmGoal::contact_onset && s->arm_goal.position_mm[0][1] < 146) hs = s;
+  REQUIRE(hs != nullptr);
+  CHECK(near(hs->arm_goal.position_mm[0][0], 10.0));
+  CHECK(near(hs->arm_goal.position_mm[0][1], 144.5));
+  // (h) the model memorizes once; both hands end open; both arms park.
+  int memorized = 0;
+  for (const Sent& s : r.sent()) memorized += s.kind == Sent::memorize;
+  CHECK(memorized == 1);
+  for (int s = 0; s < 2; ++s) {
+    const Sent* h = r.last(s, Sent::hand);
+    REQUIRE(h != nullptr);
+    CHECK(h->hand_goal.mode == HandMode::posture);
+    const Sent* a = r.last(s, Sent::arm);
+    CHECK(a->arm_goal.frame == ArmGoal::world);
+    CHECK(a->arm_goal.position_mm[0][0] == (s == kRight ? 230.0 : -230.0));
+  }
+  // Every goal has its own id, rising on each port.
+  std::set<std::uint32_t> ids;
+  for (int side = 0; side < 2; ++side)
+    for (Sent::Kind k : {Sent::arm, Sent::hand}) {
+      std::uint32_t last_id = 0;
+      for (const Sent* s : r.all(side, k)) {
+        const std::uint32_t id = k == Sent::arm ? s->arm_goal.id : s->hand_goal.id;
+        CHECK(id > last_id);
+        CHECK(ids.insert(id).second);
+        last_id = id;
+      }
+    }
+}
+
+TEST_CASE("the diagonal fold runs from its file alone: its crease, its via points") {
+  Rig r(fold_file("diagonal.yaml"));
+  r.command(Command::start);
+  REQUIRE(r.run_to("done"));
+  CHECK(r.allocations() == 0);
+  bool crease = false;
+  for (const Sent& s : r.sent())
+    if (s.kind == Sent::crease) {
+      crease = true;
+      CHECK(s.crease_event.a_mm[1] == 297.0f);
+      CHECK(s.crease_event.b_mm[0] == 210.0f);
+      CHECK(s.crease_event.b_mm[1] == 0.0f);
+    }
+  CHECK(crease);
+  const auto left = r.all(kLeft, Sent::arm);
+  REQUIRE(left.size() >= 3);
+  CHECK(near(left[2]->arm_goal.position_mm[0][0], 171.6));
+  CHECK(near(left[2]->arm_goal.position_mm[0][2], -124.5));
+}
+
+TEST_CASE("success comes from sensing: a motion that never ends holds its state until the timeout") {
+  Rig r;
+  // Failing variant first: the motion reached, the state moves on within its motion's cycles.
+  start_and_run_to(r, "fold/shift/contact");
+  Rig s;
+  s.stalls = [](int side, const ArmGoal&, int index) { return side == kRight && index == 0; };
+  s.command(Command::start);
+  s.run(5000);  // 5 s of cycles: far beyond the 20 motion cycles, well inside the 20 s timeout
+  CHECK(std::string(s.status().path) == "fold/shift/approach");
+  CHECK(s.status().time_in_state_s > 4.9);
+  expect_abort(s, crease::fold::Reason::timeout);
+  // It was the state's own timeout (20 s), not the fold's.
+  CHECK(s.cycles() < 30000);
+}
+
+TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {
+  using crease::fold::Reason;
+  SUBCASE("device fault: the arm's drive faults during a motion") {
+    Rig r;
+    start_and_run_to(r, "fold/grasp/above");
+    r.arm_fault[kLeft] = true;
+    expect_abort(r, Reason::device_fault);
+  }
+  SUBCASE("device fault: the hand's force controller inhibits (hand_state fault)") {
+    Rig r;
+    start_and_run_to(r, "fold/shift/press");
+    r.inhibit[kRight] = HandInhibit::hand_state_fault;
+    expect_abort(r, Reason::device_fault);
+  }
+  SUBCASE("force limit") {
+    Rig r;
+    start_and_run_to(r, "fold/refixate/press");
+    r.inhibit[kRight] = HandInhibit::force_limit;
+    expect_abort(r, Reason::force_limit);
+  }
+  SUBCASE("unreachable via point") {
+    Rig r;
+    // The left arm's goals: above, at the corner, then via 0, 1, 2: the third via is refused.
+    r.unreachable = [](int side, const ArmGoal&, int index) { return side == kLeft && index == 4; };
+    r.command(Command::start);
+    REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }));
+    CHECK(r.paths()[r.paths().size() - 2] == "fold/bend/follow_via[2]");
+    expect_abort(r, Reason::unreachable);
+  }
+  SUBCASE("the sheet lost by vision longer than the bound; shorter is ridden out") {
+    Rig r;
+    start_and_run_to(r, "fold/bend/follow_via[0]");
+    r.move_cycles = 3000;  // a slow via motion, so the fold stays in the bend meanwhile
+    r.observations = 0;    // the model still runs, but sees nothing
+    r.run(300);            // 0.3 s < vision_lost_max_s 0.5 s
+    CHECK(r.status().phase == SequenceStatus::running);
+    r.observations = 12;
+    r.run(100);
+    r.observations = 0;
+    r.run(400);  // 0.4 s again: the bound counts from the last time the sheet was seen
+    CHECK(r.status().phase == SequenceStatus::running);
+    r.sheet_live = false;  // now the model stops: stale sheet_state
+    expect_abort(r, Reason::vision_lost);
+  }
+  SUBCASE("a slide longer than the file allows") {
+    Rig r;
+    r.place_sheet(-105 + 200, 148.5);  // the corner 200 mm off its target
+    start_and_run_to(r, "fold/shift/press");
+    expect_abort(r, Reason::slide_out_of_range);
+  }
+  SUBCASE("the operator's abort") {
+    Rig r;
+    start_and_run_to(r, "fold/swipe/slide");
+    r.command(Command::abort);
+    expect_abort(r, Reason::operator_abort);
+    CHECK(std::string(r.status().why) == "park ended");
+  }
+}
+
+TEST_CASE("the shift's guard: a corner already in reach skips the slide") {
+  Rig r;
+  // Corner (0, 297) placed on its target (-130, -195): corner (0, 0) at (-130, 102).
+  r.place_sheet(-130, -195 + 297);
+  r.command(Command::start);
+  REQUIRE(r.run_to("fold/grasp/fixate"));
+  CHECK(std::find(r.paths().begin(), r.paths().end(), "fold/shift/slide") == r.paths().end());
+  CHECK(std::string(r.status().why) == "corner already in reach");
+}
+
+TEST_CASE("pause stops the arms and holds; resume sends the state's goal again; time in state stops") {
+  Rig r;
+  start_and_run_to(r, "fold/bend/follow_via[1]");
+  r.move_cycles = 200;
+  r.run(5);
+  const auto before = r.all(kLeft, Sent::arm).size();
+  const long paused_at = r.cycles();
+  r.command(Command::pause);
+  r.run(1);
+  CHECK(r.status().phase == SequenceStatus::paused);
+  const auto stops = r.all(kLeft, Sent::arm, paused_at);
+  REQUIRE(stops.size() == 1);
+  CHECK(stops[0]->arm_goal.kind == ArmGoal::stop);
+  const double t0 = r.status().time_in_state_s;
+  r.run(3000);  // nothing moves on while paused, not even the timeout
+  CHECK(std::string(r.status().path) == "fold/bend/follow_via[1]");
+  CHECK(r.status().time_in_state_s == t0);
+  r.command(Command::resume);
+  r.run(1);
+  const auto again = r.all(kLeft, Sent::arm, paused_at + 2);
+  REQUIRE(again.size() == 1);
+  CHECK(near(again[0]->arm_goal.position_mm[0][1], 148.5));  // via 1 again
+  CHECK(r.all(kLeft, Sent::arm).size() == before + 2);
+  // The right hand fixating the sheet was held by the pause and presses again.
+  const auto held = r.all(kRight, Sent::hand, paused_at);
+  REQUIRE(held.size() == 2);
+  CHECK(held[0]->hand_goal.mode == HandMode::hold);
+  CHECK(held[1]->hand_goal.mode == HandMode::force);
+  CHECK(held[1]->hand_goal.force_n == 2.0f);
+  REQUIRE(r.run_to("done"));
+}
+
+TEST_CASE("step mode: one transition per step") {
+  Rig r;
+  r.command(Command::step);  // from idle: start, then pause before the next transition
+  r.run(200);
+  CHECK(std::string(r.status().path) == "fold/shift/approach");
+  CHECK(r.status().phase == SequenceStatus::paused);
+  CHECK(r.status().step_mode == 1);
+  for (const char* next : {"fold/shift/contact", "fold/shift/press", "fold/shift/slide", "fold/grasp/fixate"}) {
+    r.command(Command::step);
+    r.run(200);
+    CHECK(std::string(r.status().path) == next);
+    CHECK(r.status().phase == SequenceStatus::paused);
+  }
+  r.command(Command::resume);
+  REQUIRE(r.run_to("done"));
+}
+
+TEST_CASE("a hot-swap mid-bend resumes in the same state; without the state it would start over") {
+  Rig r;
+  start_and_run_to(r, "fold/bend/follow_via[2]");
+  r.run(3);
+  std::vector<std::byte> buf(64 * 1024);
+  const std::size_t n = r.plugin().save_state(buf);
+  REQUIRE(n > 0);
+  REQUIRE(n <= buf.size());
+  const std::string path = r.status().path;
+  const std::uint32_t transitions = r.status().transitions;
+  const auto goals_before = r.sent().size();
+
+  // The failing variant: the new version without the old one's state starts in idle.
+  {
+    auto fresh = r.make_plugin();
+    CHECK(fresh->machine().memory().leaf == crease::fold::S::idle);
+  }
+  auto next = r.make_plugin();
+  REQUIRE(next->load_state(std::span<const std::byte>(buf.data(), n)));
+  r.replace_plugin(std::move(next));
+  r.run(1);
+  CHECK(std::string(r.status().path) == path);
+  CHECK(r.status().transitions == transitions);
+  CHECK(r.sent().size() == goals_before);  // nothing sent again: the via motion goes on
+  REQUIRE(r.run_to("done"));
+  CHECK(std::count(r.paths().begin(), r.paths().end(), "fold/bend/follow_via[2]") == 1);
+  // A state of another fold is refused.
+  Rig d(fold_file("diagonal.yaml"));
+  CHECK_FALSE(d.plugin().load_state(std::span<const std::byte>(buf.data(), n)));
+}
+
+TEST_CASE("the command tunable takes integers only") {
+  Rig r;
+  CHECK(r.plugin().validate_param("command", 1.0).empty());
+  CHECK_FALSE(r.plugin().validate_param("command", 1.5).empty());
+}

@@ -1,0 +1,339 @@
+// A rig for the fold_sequence plugin: the plugin on a PortRegistry of the test's own, and a
+// scripted robot standing in for the controllers and the sheet model on the same ports
+// (arm_motion's statuses, the force and contact controllers' statuses, the model's
+// sheet_state). Each cycle: the robot answers the goals it took so far (as the controllers,
+// ordered before the sequence, would in the loop), then the plugin's update, then the robot
+// takes the goals the plugin pushed. Deterministic: time is the cycle count (1 ms a cycle).
+#pragma once
+
+#include <doctest/doctest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/params.h"
+#include "core/port_binder.h"
+#include "core/port_registry.h"
+#include "core/port_types/sequence_status.h"
+#include "plugins/fold_sequence/fold_sequence_plugin.h"
+#include "rt/alloc_guard.h"
+
+namespace rig {
+
+using namespace crease;
+using crease::fold::FoldSequencePlugin;
+
+inline std::string fold_file(const char* name) { return std::string(CREASE_SOURCE_DIR) + "/config/folds/" + name; }
+
+// One goal the robot took, in order.
+struct Sent {
+  long cycle = 0;
+  int side = 0;
+  enum Kind { arm, hand, crease, memorize } kind = arm;
+  ArmGoal arm_goal{};
+  HandGoal hand_goal{};
+  SheetCreaseEvent crease_event{};
+};
+
+class Rig {
+ public:
+  explicit Rig(const std::string& fold = fold_file("half.yaml")) : fold_(fold), sheet_(std::make_unique<SheetState>()) {
+    plugin_ = make_plugin();
+    for (int s = 0; s < 2; ++s) {
+      const std::string x = s == 0 ? "r" : "l";
+      arm_out_[s] = rig_ports_.latest_output<ArmMotionStatus>("arm_" + x + "_status", ArmMotionStatus{});
+      hand_out_[s] = rig_ports_.latest_output<HandControlStatus>("hand_" + x + "_status", HandControlStatus{});
+      contact_out_[s] = rig_ports_.latest_output<ContactState>("contact_" + x + "_state", ContactState{});
+      arm_in_[s] = rig_ports_.queue_input<ArmGoal>("arm_" + x + "_goal");
+      hand_in_[s] = rig_ports_.queue_input<HandGoal>("hand_" + x + "_goal");
+    }
+    crease_in_ = rig_ports_.queue_input<SheetCreaseEvent>("sheet_crease");
+    memorize_in_ = rig_ports_.queue_input<SheetMemorizeEvent>("sheet_memorize");
+    sheet_out_ = rig_ports_.latest_output<SheetState>("sheet_state", *sheet_);
+    status_in_ = rig_ports_.latest_input<SequenceStatus>("sequence_status");
+    place_sheet(-105, 148.5);
+    for (int s = 0; s < 2; ++s) {
+      contact_[s].armed = 1;
+      contact_[s].healthy = 1;
+    }
+  }
+
+  // A new instance of the plugin on the same ports (a hot-swap's new version).
+  std::unique_ptr<FoldSequencePlugin> make_plugin() {
+    auto p = std::make_unique<FoldSequencePlugin>();
+    binders_.push_back(std::make_unique<PortBinder>(registry_, "fold", std::map<std::string, std::string>{}, &flags_, nullptr));
+    const Params params(YAML::Load("{fold: " + fold_ + "}"), "test.yaml", "fold.params");
+    ConfigureContext ctx{&params, binders_.back().get()};
+    p->attach_host(ctx);
+    p->configure(params, *binders_.back());
+    p->activate();
+    return p;
+  }
+  void replace_plugin(std::unique_ptr<FoldSequencePlugin> p) { plugin_ = std::move(p); }
+  FoldSequencePlugin& plugin() { return *plugin_; }
+
+  // What the host does for `param set fold command N`: writes the tunable between two updates.
+  void command(fold::Command c) {
+    for (Tunable& t : binders_.back()->tunables())
+      if (t.key == "command") *t.target = static_cast<double>(c);
+  }
+
+  // The flat sheet, 3 x 3 nodes, corner (0, 0) at world (x0, y0), u along +x, v along -y.
+  void place_sheet(double x0, double y0) {
+    SheetState& s = *sheet_;
+    s.nodes_u = 3;
+    s.nodes_v = 3;
+    s.width_mm = 210;
+    s.height_mm = 297;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        float* p = s.position_mm[j * 3 + i];
+        p[0] = static_cast<float>(x0 + 105.0 * i);
+        p[1] = static_cast<float>(y0 - 148.5 * j);
+        p[2] = 0;
+        s.normal[j * 3 + i][2] = -1;
+      }
+  }
+
+  // One control cycle.
+  void cycle() {
+    ++n_;
+    now_ = 1'000'000'000LL + n_ * 1'000'000LL;
+    answer();
+    Cycle c{};
+    c.time_ns = now_;
+    c.index = static_cast<std::uint64_t>(n_);
+    {
+      rt::ScopedRtMark rt_mark;
+      const std::uint64_t a0 = rt::rt_allocation_count();
+      status_ = plugin_->update(c);
+      allocations_ += rt::rt_allocation_count() - a0;
+    }
+    take();
+    (void)status_in_.poll();
+    const SequenceStatus& st = status_in_.value();
+    if (paths_.empty() || paths_.back() != st.path) paths_.push_back(st.path);
+  }
+  // Runs cycles until pred() holds (true) or max cycles passed (false).
+  bool run_until(const std::function<bool()>& pred, long max = 200000) {
+    for (long i = 0; i < max; ++i) {
+      if (pred()) return true;
+      cycle();
+    }
+    return pred();
+  }
+  bool run_to(const std::string& path, long max = 200000) {
+    return run_until([&] { return status().path == path; }, max);
+  }
+  void run(long cycles) {
+    for (long i = 0; i < cycles; ++i) cycle();
+  }
+
+  const SequenceStatus& status() const { return status_in_.value(); }
+  const std::vector<std::string>& paths() const { return paths_; }
+  const std::vector<Sent>& sent() const { return sent_; }
+  std::uint64_t allocations() const { return allocations_; }
+  long cycles() const { return n_; }
+  Status last_update_status() const { return status_; }
+
+  // The last goal sent to side's hand / arm (nullptr when none).
+  const Sent* last(int side, Sent::Kind kind) const {
+    for (auto it = sent_.rbegin(); it != sent_.rend(); ++it)
+      if (it->kind == kind && it->side == side) return &*it;
+    return nullptr;
+  }
+  std::vector<const Sent*> all(int side, Sent::Kind kind, long from_cycle = 0) const {
+    std::vector<const Sent*> out;
+    for (const Sent& s : sent_)
+      if (s.kind == kind && s.side == side && s.cycle >= from_cycle) out.push_back(&s);
+    return out;
+  }
+
+  // --- the scripted robot's knobs ---
+  int move_cycles = 20;       // a motion runs this long, then reaches (or stops on contact)
+  int settle_cycles = 15;     // a force goal settles after this
+  int posture_cycles = 10;    // a posture ramps this long
+  std::uint32_t observations = 12;  // per sheet_state
+  bool sheet_live = true;     // false: sheet_state no longer written (stale)
+  // Per arm goal (side, goal, index of the side's move goals): refuse as unreachable / never end.
+  std::function<bool(int, const ArmGoal&, int)> unreachable = [](int, const ArmGoal&, int) { return false; };
+  std::function<bool(int, const ArmGoal&, int)> stalls = [](int, const ArmGoal&, int) { return false; };
+  HandInhibit inhibit[2] = {HandInhibit::none, HandInhibit::none};
+  bool arm_fault[2] = {false, false};  // the running motion aborts with arm_fault
+
+ private:
+  struct Arm {
+    ArmMotionStatus st{};
+    ArmGoal goal{};
+    int left = 0;  // cycles to go
+    bool stall = false;
+    int moves = 0;
+  };
+  struct Hand {
+    HandControlStatus st{};
+    int left = 0;
+    bool pinch = false;
+  };
+
+  void answer() {
+    for (int s = 0; s < 2; ++s) {
+      Arm& a = arms_[s];
+      if (a.st.state == ArmMotionStatus::running) {
+        if (arm_fault[s]) {
+          a.st.state = ArmMotionStatus::aborted;
+          a.st.reason = static_cast<std::uint8_t>(ArmMotionReason::arm_fault);
+        } else if (!a.stall && --a.left <= 0) {
+          if (a.goal.stop_on == ArmGoal::contact_onset) {
+            a.st.state = ArmMotionStatus::stopped_on_contact;
+            contact_[s].in_contact = 1;
+            contact_[s].fingers = a.goal.stop_fingers;
+            ++contact_[s].onsets;
+          } else {
+            a.st.state = ArmMotionStatus::reached;
+          }
+        }
+      }
+      Hand& h = hands_[s];
+      h.st.inhibit = inhibit[s];
+      if (h.left > 0 && --h.left == 0) {
+        if (h.st.mode == HandMode::force) h.st.settled = 1;
+        if (h.st.mode == HandMode::posture) {
+          h.st.max_step_rad = 0;
+          if (h.pinch) {
+            contact_[s].in_contact = 1;
+            contact_[s].fingers = 0x11;
+          } else {
+            contact_[s].in_contact = 0;
+            contact_[s].fingers = 0;
+          }
+        }
+      }
+      a.st.timestamp_ns = h.st.timestamp_ns = contact_[s].timestamp_ns = now_;
+      arm_out_[s].write(a.st, now_);
+      hand_out_[s].write(h.st, now_);
+      contact_out_[s].write(contact_[s], now_);
+    }
+    if (sheet_live && n_ % 16 == 0) {  // the model's 60 Hz, about
+      sheet_->timestamp_ns = now_;
+      ++sheet_->step;
+      sheet_->observations = observations;
+      sheet_out_.write(*sheet_, now_);
+    }
+  }
+
+  void take() {
+    for (int s = 0; s < 2; ++s) {
+      ArmGoal g;
+      while (arm_in_[s].try_pop(g)) {
+        Sent x;
+        x.cycle = n_;
+        x.side = s;
+        x.kind = Sent::arm;
+        x.arm_goal = g;
+        sent_.push_back(x);
+        Arm& a = arms_[s];
+        if (g.kind == ArmGoal::stop) {
+          if (a.st.state == ArmMotionStatus::running) {
+            a.st.state = ArmMotionStatus::aborted;
+            a.st.reason = static_cast<std::uint8_t>(ArmMotionReason::stopped);
+          }
+          continue;
+        }
+        const int index = a.moves++;
+        if (unreachable(s, g, index)) {
+          a.st.last_refused_id = g.id;
+          a.st.last_refusal = static_cast<std::uint8_t>(ArmMotionReason::unreachable);
+          a.st.goal_id = g.id;
+          a.st.state = ArmMotionStatus::unreachable;
+          a.st.reason = static_cast<std::uint8_t>(ArmMotionReason::unreachable);
+          continue;
+        }
+        a.goal = g;
+        a.st.goal_id = g.id;
+        a.st.state = ArmMotionStatus::running;
+        a.st.reason = 0;
+        a.left = move_cycles;
+        a.stall = stalls(s, g, index);
+        if (g.stop_on == ArmGoal::stop_none && g.frame == ArmGoal::sheet && g.position_mm[0][2] < -1) {
+          contact_[s].in_contact = 0;  // lifting off
+          contact_[s].fingers = 0;
+        }
+      }
+      HandGoal hg;
+      while (hand_in_[s].try_pop(hg)) {
+        Sent x;
+        x.cycle = n_;
+        x.side = s;
+        x.kind = Sent::hand;
+        x.hand_goal = hg;
+        sent_.push_back(x);
+        Hand& h = hands_[s];
+        h.st.goal_id = hg.id;
+        h.st.mode = hg.mode;
+        ++h.st.goals_accepted;
+        h.st.settled = 0;
+        h.st.max_step_rad = 0;
+        h.left = 0;
+        if (hg.mode == HandMode::force) h.left = settle_cycles;
+        if (hg.mode == HandMode::posture) {
+          h.left = posture_cycles;
+          h.st.max_step_rad = 0.001f;
+          h.pinch = hg.target_rad[3] > 0.3f && hg.target_rad[16] > 0.3f;
+        }
+      }
+    }
+    SheetCreaseEvent ce;
+    while (crease_in_.try_pop(ce)) {
+      Sent x;
+      x.cycle = n_;
+      x.kind = Sent::crease;
+      x.crease_event = ce;
+      sent_.push_back(x);
+      const std::uint32_t k = sheet_->crease_count++;
+      for (int c = 0; c < 2; ++c) {
+        sheet_->crease_mm[k][c] = ce.a_mm[c];
+        sheet_->crease_mm[k][2 + c] = ce.b_mm[c];
+      }
+    }
+    SheetMemorizeEvent me;
+    while (memorize_in_.try_pop(me)) {
+      Sent x;
+      x.cycle = n_;
+      x.kind = Sent::memorize;
+      sent_.push_back(x);
+    }
+  }
+
+  std::string fold_;
+  PortRegistry registry_;
+  detail::OutputFlags flags_;
+  std::vector<std::unique_ptr<PortBinder>> binders_;
+  PortBinder rig_ports_{registry_, "rig", {}, &flags_, nullptr};
+  std::unique_ptr<FoldSequencePlugin> plugin_;
+  std::unique_ptr<SheetState> sheet_;
+  LatestOutput<ArmMotionStatus> arm_out_[2];
+  LatestOutput<HandControlStatus> hand_out_[2];
+  LatestOutput<ContactState> contact_out_[2];
+  QueueInput<ArmGoal> arm_in_[2];
+  QueueInput<HandGoal> hand_in_[2];
+  QueueInput<SheetCreaseEvent> crease_in_;
+  QueueInput<SheetMemorizeEvent> memorize_in_;
+  LatestOutput<SheetState> sheet_out_;
+  LatestInput<SequenceStatus> status_in_;
+  Arm arms_[2];
+  Hand hands_[2];
+  ContactState contact_[2]{};
+  long n_ = 0;
+  std::int64_t now_ = 0;
+  Status status_ = Status::ok;
+  std::uint64_t allocations_ = 0;
+  std::vector<std::string> paths_;
+  std::vector<Sent> sent_;
+};
+
+}  // namespace rig
