@@ -29,7 +29,7 @@ string(REGEX REPLACE ".* ([0-9]+)u?$" "\\1" CREASE_ABI_VERSION "${abi_line}")
 set(CREASE_SDK_VERSION ${CREASE_ABI_VERSION}.${PROJECT_VERSION_MINOR}.${PROJECT_VERSION_PATCH})
 
 # --- programs and shared libraries
-install(TARGETS creased creasectl crease-markers crease-calibrate crease-simdevice
+install(TARGETS creased creasectl crease-markers crease-calibrate crease-simdevice crease-fold-graph
         RUNTIME DESTINATION bin COMPONENT runtime)
 set_target_properties(crease_rt PROPERTIES EXPORT_NAME rt)
 set_target_properties(crease_frames PROPERTIES EXPORT_NAME frames)

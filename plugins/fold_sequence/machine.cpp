@@ -144,8 +144,12 @@ void Machine::apply_command(const Sensing& in, Outbox& out) noexcept {
       }
       break;
     case Command::step:
-    case Command::resume:
+    case Command::resume: {
       m_.step_mode = c == Command::step ? 1 : 0;
+      if (!folding) {
+        if (c == Command::step && !is_within(m_.leaf, S::abort)) m_.start_pending = 1;  // start, then pause
+        break;
+      }
       if (m_.gate_row >= 0) {
         const Row& r = all_rows().begin[m_.gate_row];
         go(r.to, r.reason, m_.gate_row, in, out);
@@ -154,15 +158,14 @@ void Machine::apply_command(const Sensing& in, Outbox& out) noexcept {
         exit(m_.leaf, in, out);
         m_.self_entry = 0;
         enter(m_.leaf, in, out);  // the state's commands again, from where the robot stopped
-        for (int s = 0; s < 2; ++s) {  // and the hands the pause held press again (unless the state sent them a goal)
-          if (m_.held_by_pause[s] && out.hand_count[s] == 0)
-            hand_force(s, m_.force_fingers[s], m_.force_n[s], in, out);
-          m_.held_by_pause[s] = 0;
-        }
-      } else if (!folding && c == Command::step && !is_within(m_.leaf, S::abort)) {
-        m_.start_pending = 1;  // step from idle: start, pausing before the first transition
+      }
+      for (int s = 0; s < 2; ++s) {  // the hands a pause held press again, unless the state sent them a goal
+        if (m_.held_by_pause[s] && out.hand_count[s] == 0 && is_within(m_.leaf, S::fold))
+          hand_force(s, m_.force_fingers[s], m_.force_n[s], in, out);
+        m_.held_by_pause[s] = 0;
       }
       break;
+    }
     case Command::abort:
       if (folding) go(S::abort, Reason::operator_abort, -1, in, out);
       break;
@@ -188,20 +191,25 @@ void Machine::step(const Sensing& in, Outbox& out) noexcept {
   }
   const bool held = m_.paused || m_.gate_row >= 0;
   const RowSpan rows = all_rows();
-  for (S owner = m_.leaf; owner != S::root; owner = state_info(owner).parent) {
-    const RowSpan own = rows_of(owner);
-    for (const Row* r = own.begin; r != own.end; ++r) {
-      if (held && r->ev != Ev::fault) continue;  // paused: only a fault moves it (to abort)
-      if (!holds(r->ev, owner, in) || !passes(r->guard, in)) continue;
-      const int index = static_cast<int>(r - rows.begin);
-      const Reason why = r->ev == Ev::fault ? detected_ : r->reason;
-      if (m_.step_mode && !is_within(r->to, S::abort) && r->to != S::aborted && r->ev != Ev::start) {
-        m_.gate_row = static_cast<std::int16_t>(index);  // held until `step` or `resume`
+  // Two passes: a fault's rows (fold's) first, so that a fault preempts any success of the same
+  // cycle; then every other row, the innermost state's first. A paused machine: faults only.
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1 && held) return;
+    for (S owner = m_.leaf; owner != S::root; owner = state_info(owner).parent) {
+      const RowSpan own = rows_of(owner);
+      for (const Row* r = own.begin; r != own.end; ++r) {
+        if ((r->ev == Ev::fault) != (pass == 0)) continue;
+        if (!holds(r->ev, owner, in) || !passes(r->guard, in)) continue;
+        const int index = static_cast<int>(r - rows.begin);
+        const Reason why = r->ev == Ev::fault ? detected_ : r->reason;
+        if (m_.step_mode && !is_within(r->to, S::abort) && r->to != S::aborted && r->ev != Ev::start) {
+          m_.gate_row = static_cast<std::int16_t>(index);  // held until `step` or `resume`
+          return;
+        }
+        go(r->to, why, index, in, out);
+        m_.start_pending = 0;
         return;
       }
-      go(r->to, why, index, in, out);
-      m_.start_pending = 0;
-      return;
     }
   }
 }

@@ -273,6 +273,17 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
     start_and_run_to(r, "fold/shift/press");
     expect_abort(r, Reason::slide_out_of_range);
   }
+  SUBCASE("a fault preempts a success seen in the same cycle") {
+    Rig r;
+    start_and_run_to(r, "fold/shift/approach");  // the approach goal taken this cycle
+    r.run(r.move_cycles - 1);
+    CHECK(std::string(r.status().path) == "fold/shift/approach");
+    r.inhibit[kRight] = HandInhibit::tactile_stale;  // seen in the cycle the approach is reached
+    r.cycle();
+    CHECK(std::string(r.status().path) == "abort/stop");
+    CHECK(std::find(r.paths().begin(), r.paths().end(), "fold/shift/contact") == r.paths().end());
+    expect_abort(r, Reason::device_fault);
+  }
   SUBCASE("the operator's abort") {
     Rig r;
     start_and_run_to(r, "fold/swipe/slide");
