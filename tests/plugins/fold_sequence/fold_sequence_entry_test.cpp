@@ -1,0 +1,85 @@
+// The fold_sequence library as creased loads it: in a real 1 kHz loop of the plugin host, the
+// `command` tunable set through the host's param path (what `creasectl sequence start` sends)
+// starts the fold; with no controller answering it aborts at once as a device fault and the
+// retreat's first goals reach the hands (hold, then the open posture). A bad fold file is a
+// load error naming it. No timing thresholds: the waits are bounded in count only.
+#include <doctest/doctest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include "core/errors.h"
+#include "core/plugin_host.h"
+#include "core/port.h"
+#include "core/port_types/hand_goal.h"
+#include "core/port_types/sequence_status.h"
+
+using namespace std::chrono_literals;
+
+namespace {
+
+crease::InstanceSpec spec(const std::string& fold) {
+  crease::InstanceSpec s;
+  s.name = "fold";
+  s.library = "fold_sequence";
+  s.loop = "control";
+  s.params = crease::Params(YAML::Load("{fold: " + fold + "}"), "test.yaml", "fold.params");
+  return s;
+}
+
+crease::SequenceStatus status(const crease::PluginHost& host) {
+  crease::SequenceStatus s{};
+  const auto* ch = host.ports().find_latest("sequence_status");
+  if (ch != nullptr) (void)ch->read(&s, 0);
+  return s;
+}
+
+template <class Pred>
+bool wait(Pred pred) {
+  for (int i = 0; i < 20000; ++i) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(1ms);
+  }
+  return pred();
+}
+
+}  // namespace
+
+TEST_CASE("loaded by the host: started through its param path, aborted without controllers, hands sent hold then open") {
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"control", 1000.0, 0, -1});
+  host.add_instance(spec(std::string(CREASE_SOURCE_DIR) + "/config/folds/half.yaml"));
+  crease::QueueInput<crease::HandGoal> hand_r(host.ports().bind_queue_reader(
+      "hand_r_goal", crease::port_type_of<crease::HandGoal>(), "test", crease::PortRegistry::kDefaultQueueCapacity));
+  host.start();
+  REQUIRE(wait([&] { return std::string(status(host).path) == "idle"; }));
+  CHECK_FALSE(host.set_param("fold", "command", 1.5).empty());  // not a command
+  CHECK(host.set_param("fold", "command", 1.0).empty());        // start
+  REQUIRE(wait([&] { return std::string(status(host).path) == "abort/open"; }));
+  const crease::SequenceStatus s = status(host);
+  CHECK(s.abort_reason == 4);  // Reason::device_fault: nobody answers
+  CHECK(s.aborts == 1);
+  CHECK(std::string(s.fold) == "half");
+  host.stop();
+  crease::HandGoal g{};
+  std::vector<crease::HandMode> modes;
+  while (hand_r.try_pop(g)) modes.push_back(g.mode);
+  // shift/approach opened the hand, then the abort: hold (no more force), then open.
+  REQUIRE(modes.size() >= 2);
+  CHECK(modes[modes.size() - 2] == crease::HandMode::hold);
+  CHECK(modes.back() == crease::HandMode::posture);
+}
+
+TEST_CASE("a malformed fold file is a load error naming the file and key") {
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"control", 1000.0, 0, -1});
+  const std::string missing = std::string(CREASE_SOURCE_DIR) + "/config/folds/none.yaml";
+  try {
+    host.add_instance(spec(missing));
+    FAIL("loaded");
+  } catch (const std::exception& e) {
+    CHECK(std::string(e.what()).find(missing) != std::string::npos);
+  }
+}
