@@ -1,0 +1,107 @@
+// The machine alone (no ports): what the plugin tests do not reach through the rig: a memory
+// refused on restore, a lost command aborting with its reason, the status texts.
+#include "plugins/fold_sequence/machine.h"
+
+#include <doctest/doctest.h>
+
+#include <memory>
+#include <string>
+
+using namespace crease;
+using namespace crease::fold;
+
+namespace {
+FoldSpec half() { return load_fold_file(std::string(CREASE_SOURCE_DIR) + "/config/folds/half.yaml"); }
+
+// Controllers that answer (fresh, healthy) but never finish anything.
+struct Quiet {
+  ArmMotionStatus arm[2]{};
+  HandControlStatus hand[2]{};
+  ContactState contact[2]{};
+  std::unique_ptr<SheetState> sheet = std::make_unique<SheetState>();
+  Sensing at(std::int64_t now) {
+    Sensing in;
+    in.now_ns = now;
+    for (int s = 0; s < 2; ++s) {
+      arm[s].timestamp_ns = hand[s].timestamp_ns = contact[s].timestamp_ns = now;
+      contact[s].healthy = contact[s].armed = 1;
+      in.arm[s] = &arm[s];
+      in.hand[s] = &hand[s];
+      in.contact[s] = &contact[s];
+    }
+    sheet->timestamp_ns = now;
+    sheet->observations = 10;
+    in.sheet = sheet.get();
+    return in;
+  }
+};
+}  // namespace
+
+TEST_CASE("restore refuses a memory of another version, fold or a superstate") {
+  const FoldSpec f = half();
+  Machine m(f);
+  Memory saved = m.memory();
+  saved.leaf = S::follow_via;
+  saved.via = 2;
+  Memory bad = saved;
+  bad.version = Memory::kVersion + 1;
+  CHECK_FALSE(m.restore(bad));
+  bad = saved;
+  bad.spec_hash ^= 1;
+  CHECK_FALSE(m.restore(bad));
+  bad = saved;
+  bad.leaf = S::bend;  // not a leaf
+  CHECK_FALSE(m.restore(bad));
+  CHECK(m.memory().leaf == S::idle);  // nothing changed
+  REQUIRE(m.restore(saved));
+  SequenceStatus st;
+  m.fill_status(st, 5);
+  CHECK(std::string(st.path) == "fold/bend/follow_via[2]");
+  CHECK(std::string(st.fold) == "half");
+}
+
+TEST_CASE("a command the plugin could not queue aborts the fold with command_lost") {
+  const FoldSpec f = half();
+  Machine m(f);
+  Quiet q;
+  Outbox out;
+  m.command(Command::start);
+  m.step(q.at(1'000'000), out);
+  SequenceStatus st;
+  m.fill_status(st, 1'000'000);
+  CHECK(std::string(st.path) == "fold/shift/approach");
+  CHECK(std::string(st.why) == "start");
+  CHECK(out.arm_count[kRight] == 1);
+  CHECK(out.hand_count[kRight] == 1);
+  CHECK(out.hand_count[kLeft] == 1);
+  m.step(q.at(2'000'000), out);  // nothing finished: it waits
+  m.fill_status(st, 2'000'000);
+  CHECK(std::string(st.path) == "fold/shift/approach");
+  CHECK(out.arm_count[kRight] == 0);
+  m.fail(Reason::command_lost);
+  m.step(q.at(3'000'000), out);
+  m.fill_status(st, 3'000'000);
+  CHECK(std::string(st.path) == "abort/stop");
+  CHECK(std::string(st.why) == "abort: command_lost");
+  CHECK(st.abort_reason == static_cast<std::uint8_t>(Reason::command_lost));
+  CHECK(st.phase == SequenceStatus::aborted);
+  // The retreat's first goals: hold to both hands, stop to both arms.
+  CHECK(out.hand[kRight][0].mode == HandMode::hold);
+  CHECK(out.hand[kLeft][0].mode == HandMode::hold);
+  CHECK(out.arm[kRight][0].kind == ArmGoal::stop);
+  CHECK(out.arm[kLeft][0].kind == ArmGoal::stop);
+}
+
+TEST_CASE("outside the fold, pause, resume and abort do nothing; start only from a resting state") {
+  const FoldSpec f = half();
+  Machine m(f);
+  Quiet q;
+  Outbox out;
+  for (Command c : {Command::pause, Command::resume, Command::abort}) {
+    m.command(c);
+    m.step(q.at(1'000'000), out);
+    CHECK(m.memory().leaf == S::idle);
+    CHECK(out.arm_count[0] + out.arm_count[1] + out.hand_count[0] + out.hand_count[1] == 0);
+  }
+  CHECK(m.phase() == SequenceStatus::idle);
+}

@@ -1,0 +1,86 @@
+// What the sequence reads of the tracked sheet: its frame (as arm_motion builds it), a node by
+// its sheet coordinates, the model's crease nearest to a line.
+#include "plugins/fold_sequence/sheet_geometry.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+using namespace crease;
+using namespace crease::fold;
+
+namespace {
+// A flat W x H sheet, corner (0, 0) at (x0, y0), turned by yaw about z (u along (cos, sin)).
+std::unique_ptr<SheetState> sheet(int w, int h, double x0, double y0, double yaw) {
+  auto s = std::make_unique<SheetState>();
+  s->nodes_u = static_cast<std::uint16_t>(w);
+  s->nodes_v = static_cast<std::uint16_t>(h);
+  s->width_mm = 210;
+  s->height_mm = 297;
+  const double c = std::cos(yaw), sn = std::sin(yaw);
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      const double u = 210.0 * i / (w - 1), v = 297.0 * j / (h - 1);
+      // v runs along the sheet's -y (printed face up: z = u x v into the table).
+      float* p = s->position_mm[j * w + i];
+      p[0] = static_cast<float>(x0 + c * u + sn * v);
+      p[1] = static_cast<float>(y0 + sn * u - c * v);
+      p[2] = 0;
+    }
+  return s;
+}
+}  // namespace
+
+TEST_CASE("the sheet frame: origin at node (0, 0), x along u, z = u x v into the table") {
+  const double yaw = 15 * std::numbers::pi / 180;
+  const auto s = sheet(5, 7, -105, 148.5, yaw);
+  SheetFrame f;
+  REQUIRE(sheet_frame(*s, f));
+  CHECK(f.origin[0] == doctest::Approx(-105));
+  CHECK(f.origin[1] == doctest::Approx(148.5));
+  CHECK(f.x[0] == doctest::Approx(std::cos(yaw)));
+  CHECK(f.x[1] == doctest::Approx(std::sin(yaw)));
+  CHECK(f.z[2] == doctest::Approx(-1));  // into the table
+  CHECK(f.y[0] == doctest::Approx(std::sin(yaw)));  // y along v: the world's -y turned by the yaw
+  CHECK(f.y[1] == doctest::Approx(-std::cos(yaw)));
+  double p[3];
+  REQUIRE(node_at(*s, 210, 297, p));  // the far corner
+  CHECK(p[0] == doctest::Approx(-105 + std::cos(yaw) * 210 + std::sin(yaw) * 297).epsilon(1e-6));
+  REQUIRE(node_at(*s, 52, 50, p));  // the nearest node: (1, 1) at u 52.5, v 49.5
+  CHECK(p[0] == doctest::Approx(-105 + std::cos(yaw) * 52.5 + std::sin(yaw) * 49.5).epsilon(1e-6));
+}
+
+TEST_CASE("degenerate sheets have no frame") {
+  auto s = sheet(3, 3, 0, 0, 0);
+  s->position_mm[2][0] = s->position_mm[0][0];  // node (W-1, 0) on the origin
+  s->position_mm[2][1] = s->position_mm[0][1];
+  SheetFrame f;
+  CHECK_FALSE(sheet_frame(*s, f));
+  s = sheet(3, 3, 0, 0, 0);
+  s->position_mm[0][2] = std::nanf("");
+  CHECK_FALSE(sheet_frame(*s, f));
+  s->nodes_u = 1;
+  double p[3];
+  CHECK_FALSE(node_at(*s, 0, 0, p));
+}
+
+TEST_CASE("the model's crease nearest to the intended line, in the line's direction") {
+  auto s = sheet(3, 3, 0, 0, 0);
+  double a[2] = {0, 148.5}, b[2] = {210, 148.5};
+  CHECK_FALSE(nearest_crease(*s, a, b));  // none: the line is left as it is
+  CHECK(a[1] == 148.5);
+  s->crease_count = 2;
+  const float far[4] = {0, 20, 210, 20};
+  const float near_flipped[4] = {210, 150, 0, 147};
+  for (int c = 0; c < 4; ++c) {
+    s->crease_mm[0][c] = far[c];
+    s->crease_mm[1][c] = near_flipped[c];
+  }
+  REQUIRE(nearest_crease(*s, a, b));
+  CHECK(a[0] == 0);
+  CHECK(a[1] == 147);
+  CHECK(b[0] == 210);
+  CHECK(b[1] == 150);
+}
