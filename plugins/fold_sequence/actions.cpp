@@ -152,6 +152,9 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
   const FoldSpec& f = spec_;
   switch (s) {
     case S::fold:
+      // An inhibit the force controller latched before the fold (it clears on its next goal)
+      // is not this fold's fault: only new ones count.
+      for (int s2 = 0; s2 < 2; ++s2) m_.inhibits0[s2] = in.hand[s2] != nullptr ? in.hand[s2]->inhibits : 0;
       m_.via = 0;
       m_.vision_bad_since_ns = 0;
       m_.abort_reason = Reason::none;

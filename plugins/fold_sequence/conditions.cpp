@@ -45,7 +45,10 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
   auto posed = [&](int s) {
     const HandControlStatus* h = in.hand[s];
     if (m_.hand_id[s] == 0) return true;
-    return h != nullptr && h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture && h->max_step_rad <= 1e-6f;
+    if (h == nullptr) return false;
+    // Refused (in the fold a fault first), or the controller's own retreat: nothing more to wait for.
+    if (h->goals_refused > m_.hand_refused0[s] || h->mode == HandMode::retreat) return true;
+    return h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture && h->max_step_rad <= 1e-6f;
   };
   switch (ev) {
     case Ev::start: return m_.start_pending != 0;
@@ -100,6 +103,22 @@ bool Machine::passes(Guard g, const Sensing& in) const noexcept {
   double d[2];
   switch (g) {
     case Guard::none: return true;
+    case Guard::ready: {
+      const SheetState* sh = in.sheet;
+      if (sh == nullptr || !fresh(sh->timestamp_ns, in.now_ns, spec_.sheet_max_age_s) ||
+          sh->observations < spec_.min_observations)
+        return false;
+      for (int s = 0; s < 2; ++s) {
+        const HandControlStatus* h = in.hand[s];
+        const ArmMotionStatus* a = in.arm[s];
+        const ContactState* c = in.contact[s];
+        if (h == nullptr || a == nullptr || c == nullptr || !fresh(h->timestamp_ns, in.now_ns, spec_.status_max_age_s) ||
+            !fresh(a->timestamp_ns, in.now_ns, spec_.status_max_age_s) ||
+            !fresh(c->timestamp_ns, in.now_ns, spec_.status_max_age_s) || c->healthy == 0 || h->commanding == 0)
+          return false;
+      }
+      return true;
+    }
     case Guard::slide_needed: {
       const double l = slide_length(in, d);
       return l > spec_.shift_tolerance_mm && l <= spec_.max_slide_mm;
@@ -139,8 +158,10 @@ Reason Machine::fault(const Sensing& in) noexcept {
     if (a == nullptr || !fresh(a->timestamp_ns, now, spec_.status_max_age_s)) return Reason::device_fault;
     if (c == nullptr || !fresh(c->timestamp_ns, now, spec_.status_max_age_s) || c->healthy == 0)
       return Reason::device_fault;
-    if (h->inhibit == HandInhibit::force_limit) return Reason::force_limit;
-    if (h->inhibit != HandInhibit::none) return Reason::device_fault;
+    // The force controller stopped adding force since the fold began (its inhibits counter
+    // rose): over its force limit, or its inputs went bad.
+    if (h->inhibits > m_.inhibits0[s] && h->inhibit != HandInhibit::none)
+      return h->inhibit == HandInhibit::force_limit ? Reason::force_limit : Reason::device_fault;
     if (m_.hand_id[s] != 0 && h->goals_refused > m_.hand_refused0[s]) return Reason::goal_refused;
     const std::uint32_t id = m_.arm_id[s];
     if (id == 0) continue;

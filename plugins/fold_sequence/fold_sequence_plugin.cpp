@@ -8,6 +8,11 @@ namespace crease::fold {
 void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
   spec_ = load_fold_file(p.get_path("fold"));
   auto_start_ = p.get<bool>("auto_start", false);
+  const double poll_ms = p.get_in_range<double>("sheet_poll_ms", 200.0, 0.0, 1000.0);
+  if (poll_ms * 1e-3 >= spec_.sheet_max_age_s)
+    p.fail("sheet_poll_ms", "must be below the fold's sensing.sheet_max_age_s (" +
+                                format_number(spec_.sheet_max_age_s * 1e3) + " ms), else a live sheet reads as stale");
+  sheet_poll_ns_ = static_cast<std::int64_t>(poll_ms * 1e6);
   machine_ = std::make_unique<Machine>(spec_);
   outbox_ = std::make_unique<Outbox>();
   ports.tunable("command", &command_, 0.0, 5.0);
@@ -18,7 +23,7 @@ void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
     hand_status_[s] = ports.latest_input<HandControlStatus>("hand_" + x + "_status");
     contact_[s] = ports.latest_input<ContactState>("contact_" + x + "_state");
     arm_goal_[s] = ports.queue_output<ArmGoal>("arm_" + x + "_goal");
-    hand_goal_[s] = ports.queue_output<HandGoal>("hand_" + x + "_goal");
+    hand_goal_[s] = ports.queue_output<HandGoal>("hand_" + x + "_goal", kHandGoalQueue);
   }
   sheet_ = ports.latest_input<SheetState>("sheet_state");
   crease_ = ports.queue_output<SheetCreaseEvent>("sheet_crease");
@@ -51,7 +56,13 @@ Status FoldSequencePlugin::update(const Cycle& c) {
     if (hand_status_[s].has_value()) in.hand[s] = &hand_status_[s].value();
     if (contact_[s].has_value()) in.contact[s] = &contact_[s].value();
   }
-  (void)sheet_.poll();
+  // The sheet (164 kB a copy) only while folding (or waiting to start), and at most every sheet_poll_ms: a copy per
+  // model frame would cost the control loop tens of microseconds on 60 cycles a second.
+  const bool folding = is_within(machine_->memory().leaf, S::fold) || machine_->memory().start_pending;
+  if (folding && (sheet_polled_ns_ == 0 || c.time_ns - sheet_polled_ns_ >= sheet_poll_ns_)) {
+    (void)sheet_.poll();
+    sheet_polled_ns_ = c.time_ns;
+  }
   if (sheet_.has_value()) in.sheet = &sheet_.value();
 
   Outbox& out = *outbox_;
@@ -67,9 +78,10 @@ Status FoldSequencePlugin::update(const Cycle& c) {
 
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);
-  if (status_value_.transitions != logged_transitions_) {
+  if (status_value_.transitions != logged_transitions_) {  // each transition: the new path, then why
     logged_transitions_ = status_value_.transitions;
     log_rt(rt::LogLevel::info, status_value_.path, static_cast<std::int64_t>(status_value_.transitions));
+    log_rt(rt::LogLevel::info, status_value_.why);
   }
   return status_value_.phase == SequenceStatus::aborted ? Status::degraded : Status::ok;
 }

@@ -7,13 +7,15 @@
 //   arm_r_status, arm_l_status    latest in   crease::ArmMotionStatus  (arm_motion per arm)
 //   hand_r_status, hand_l_status  latest in   crease::HandControlStatus (force_controller per hand)
 //   contact_r_state, contact_l_state latest in crease::ContactState   (contact_controller per hand)
-//   sheet_state                   latest in   crease::SheetState (the model's; 164 kB copied per new frame)
+//   sheet_state                   latest in   crease::SheetState (the model's: 164 kB, copied at most
+//                                             every sheet_poll_ms, and only while folding)
 //   arm_r_goal, arm_l_goal        queue out   crease::ArmGoal
 //   hand_r_goal, hand_l_goal      queue out   crease::HandGoal
 //   sheet_crease                  queue out   crease::SheetCreaseEvent
 //   sheet_memorize                queue out   crease::SheetMemorizeEvent
 //   sequence_status               latest out  crease::SequenceStatus (creasectl status shows it)
-// Parameters: fold (path of a sequence file, required), auto_start (false). Tunable `command`
+// Parameters: fold (path of a sequence file, required), auto_start (false), sheet_poll_ms (200;
+// must stay below the file's sheet_max_age_s less the model's period). Tunable `command`
 // (0..5, integers): 1 start, 2 pause, 3 resume, 4 abort, 5 step; read once and reset to 0 by
 // the plugin (`creasectl sequence start|pause|resume|abort|step` sets it).
 #pragma once
@@ -32,6 +34,10 @@ namespace crease::fold {
 
 class FoldSequencePlugin final : public Plugin {
  public:
+  // A queue's writer and reader must agree on its capacity: force_controller reads hand_goal
+  // with 16 records (its kGoalQueue); arm_motion and sheet_model read with the default.
+  static constexpr std::size_t kHandGoalQueue = 16;
+
   void configure(const Params& p, PortBinder& ports) override;
   void activate() override;
   Status update(const Cycle& c) override;
@@ -48,6 +54,8 @@ class FoldSequencePlugin final : public Plugin {
   std::unique_ptr<Outbox> outbox_;
   bool auto_start_ = false;
   bool started_ = false;
+  std::int64_t sheet_poll_ns_ = 200'000'000;
+  std::int64_t sheet_polled_ns_ = 0;  // the cycle time of the last poll of sheet_state (0: never)
   double command_ = 0;  // the tunable: a Command, 0 when none is waiting
   std::uint32_t logged_transitions_ = 0;
   LatestInput<ArmMotionStatus> arm_status_[2];

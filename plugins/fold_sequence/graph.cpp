@@ -37,6 +37,7 @@ const char* event_name(Ev e) {
 const char* guard_name(Guard g) {
   switch (g) {
     case Guard::none: return "";
+    case Guard::ready: return "controllers, sheet ready";
     case Guard::slide_needed: return "slide needed";
     case Guard::slide_short: return "corner in reach";
     case Guard::slide_too_long: return "slide too long";

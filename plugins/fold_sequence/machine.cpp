@@ -78,6 +78,8 @@ void Machine::fill_status(SequenceStatus& s, std::int64_t now_ns) const noexcept
   } else if (m_.last_reason != Reason::none) {
     copy_text(s.why, sizeof s.why, "abort: ", reason_name(m_.last_reason));
   }
+  if (m_.start_pending && !is_within(m_.leaf, S::fold) && !is_within(m_.leaf, S::abort))
+    copy_text(s.why, sizeof s.why, "start: waiting for the controllers and the sheet");
   copy_text(s.fold, sizeof s.fold, spec_.name.c_str());
 }
 

@@ -86,6 +86,7 @@ struct Memory {
   std::uint32_t arm_id[2] = {0, 0};   // this state's arm goals (0: none)
   std::uint32_t hand_id[2] = {0, 0};  // this state's hand goals
   std::uint64_t hand_refused0[2] = {0, 0};  // goals_refused when that hand goal was sent
+  std::uint64_t inhibits0[2] = {0, 0};      // the hands' inhibits counters when the fold began
   HandMode hand_mode[2] = {HandMode::hold, HandMode::hold};  // the mode last asked of each hand
   std::uint8_t force_fingers[2] = {0, 0};  // the last force goal of each hand, for a resume
   float force_n[2] = {0, 0};

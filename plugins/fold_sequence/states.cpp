@@ -73,7 +73,7 @@ constexpr Reason C = Reason::condition;
 // Rows by state, in S's order (rows_of relies on it). The first row whose event holds and whose
 // guard passes fires; a state's rows come before its superstates'.
 constexpr Row kRows[] = {
-    {S::idle, Ev::start, Guard::none, S::fold, Reason::started, "start"},
+    {S::idle, Ev::start, Guard::ready, S::fold, Reason::started, "start"},
 
     {S::fold, Ev::fault, Guard::none, S::abort, Reason::device_fault, "fault"},  // reason: the detector's
     {S::fold, Ev::timeout, Guard::none, S::abort, Reason::timeout, "state timeout"},
@@ -124,7 +124,7 @@ constexpr Row kRows[] = {
     {S::finish_lift, Ev::arms_reached, Guard::none, S::finish_park, C, "hands lifted"},
     {S::finish_park, Ev::arms_reached, Guard::none, S::done, C, "arms parked"},
 
-    {S::done, Ev::start, Guard::none, S::fold, Reason::started, "start"},
+    {S::done, Ev::start, Guard::ready, S::fold, Reason::started, "start"},
 
     {S::abort, Ev::timeout, Guard::none, S::aborted, Reason::timeout, "abort timed out"},
     {S::abort_stop, Ev::stopped, Guard::none, S::abort_open, C, "force stopped, arms still"},
@@ -136,7 +136,7 @@ constexpr Row kRows[] = {
     {S::abort_park, Ev::arms_done, Guard::none, S::aborted, C, "park ended"},
     {S::abort_park, Ev::timeout, Guard::none, S::aborted, Reason::timeout, "park timed out"},
 
-    {S::aborted, Ev::start, Guard::none, S::fold, Reason::started, "start"},
+    {S::aborted, Ev::start, Guard::ready, S::fold, Reason::started, "start"},
 };
 constexpr int kRowCount = static_cast<int>(sizeof(kRows) / sizeof(kRows[0]));
 

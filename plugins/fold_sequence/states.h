@@ -59,6 +59,7 @@ enum class Ev : std::uint8_t {
 
 enum class Guard : std::uint8_t {
   none,
+  ready,          // start: every controller answers (fresh; contact healthy; the hand commanded), the sheet is seen
   slide_needed,   // shift: the corner is further than the tolerance from its target
   slide_short,    // shift: not needed (already there)
   slide_too_long, // shift: longer than max_slide_mm

@@ -215,9 +215,10 @@ TEST_CASE("success comes from sensing: a motion that never ends holds its state 
   Rig s;
   s.stalls = [](int side, const ArmGoal&, int index) { return side == kRight && index == 0; };
   s.command(Command::start);
+  REQUIRE(s.run_to("fold/shift/approach"));
   s.run(5000);  // 5 s of cycles: far beyond the 20 motion cycles, well inside the 20 s timeout
   CHECK(std::string(s.status().path) == "fold/shift/approach");
-  CHECK(s.status().time_in_state_s > 4.9);
+  CHECK(s.status().time_in_state_s > 4.99);
   expect_abort(s, crease::fold::Reason::timeout);
   // It was the state's own timeout (20 s), not the fold's.
   CHECK(s.cycles() < 30000);
@@ -236,6 +237,18 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
     start_and_run_to(r, "fold/shift/press");
     r.inhibit[kRight] = HandInhibit::hand_state_fault;
     expect_abort(r, Reason::device_fault);
+  }
+  SUBCASE("device fault: the hand's inputs go bad and it refuses every goal: the retreat goes on") {
+    Rig r;
+    start_and_run_to(r, "fold/grasp/fixate");
+    r.inhibit[kRight] = HandInhibit::hand_state_fault;
+    r.refuse_hand_goals[kRight] = true;
+    REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }));
+    const long c0 = r.cycles();
+    REQUIRE(r.run_to("aborted"));
+    CHECK(r.cycles() - c0 < 1000);  // not the open step's 20 s timeout: a refused goal ends it
+    CHECK(r.status().abort_reason == static_cast<std::uint8_t>(Reason::device_fault));
+    CHECK(r.last(kLeft, Sent::hand)->hand_goal.mode == HandMode::posture);  // the other hand opened
   }
   SUBCASE("force limit") {
     Rig r;
@@ -293,6 +306,32 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
   }
 }
 
+TEST_CASE("the start waits until the controllers answer and the sheet is seen") {
+  Rig r;
+  r.observations = 0;  // the model runs but vision sees nothing
+  r.command(Command::start);
+  r.run(2000);
+  CHECK(std::string(r.status().path) == "idle");
+  CHECK(std::string(r.status().why) == "start: waiting for the controllers and the sheet");
+  CHECK(r.sent().empty());
+  r.observations = 12;
+  REQUIRE(r.run_to("fold/shift/approach", 1000));
+  CHECK(std::string(r.status().why) == "start");
+  r.inhibit[kLeft] = HandInhibit::hand_state_stale;
+  expect_abort(r, crease::fold::Reason::device_fault);
+  // A start after the abort: the inhibit the controller latched (until its next goal) is not
+  // the new fold's fault; the sheet lost is the guard's business again.
+  r.sheet_live = false;
+  r.run(1000);  // the model's last state goes stale
+  r.command(Command::start);
+  r.run(1000);
+  CHECK(std::string(r.status().path) == "aborted");
+  r.sheet_live = true;
+  REQUIRE(r.run_to("fold/shift/approach", 1000));
+  REQUIRE(r.run_to("fold/grasp/above", 1000));  // the latched inhibit aborts nothing
+  CHECK(r.status().phase == SequenceStatus::running);
+}
+
 TEST_CASE("the shift's guard: a corner already in reach skips the slide") {
   Rig r;
   // Corner (0, 297) placed on its target (-130, -195): corner (0, 0) at (-130, 102).
@@ -338,7 +377,7 @@ TEST_CASE("pause stops the arms and holds; resume sends the state's goal again; 
 TEST_CASE("step mode: one transition per step") {
   Rig r;
   r.command(Command::step);  // from idle: start, then pause before the next transition
-  r.run(200);
+  r.run(500);
   CHECK(std::string(r.status().path) == "fold/shift/approach");
   CHECK(r.status().phase == SequenceStatus::paused);
   CHECK(r.status().step_mode == 1);

@@ -25,6 +25,7 @@ struct Quiet {
     for (int s = 0; s < 2; ++s) {
       arm[s].timestamp_ns = hand[s].timestamp_ns = contact[s].timestamp_ns = now;
       contact[s].healthy = contact[s].armed = 1;
+      hand[s].commanding = 1;
       in.arm[s] = &arm[s];
       in.hand[s] = &hand[s];
       in.contact[s] = &contact[s];

@@ -50,7 +50,7 @@ class Rig {
       hand_out_[s] = rig_ports_.latest_output<HandControlStatus>("hand_" + x + "_status", HandControlStatus{});
       contact_out_[s] = rig_ports_.latest_output<ContactState>("contact_" + x + "_state", ContactState{});
       arm_in_[s] = rig_ports_.queue_input<ArmGoal>("arm_" + x + "_goal");
-      hand_in_[s] = rig_ports_.queue_input<HandGoal>("hand_" + x + "_goal");
+      hand_in_[s] = rig_ports_.queue_input<HandGoal>("hand_" + x + "_goal", FoldSequencePlugin::kHandGoalQueue);  // as force_controller
     }
     crease_in_ = rig_ports_.queue_input<SheetCreaseEvent>("sheet_crease");
     memorize_in_ = rig_ports_.queue_input<SheetMemorizeEvent>("sheet_memorize");
@@ -165,6 +165,7 @@ class Rig {
   std::function<bool(int, const ArmGoal&, int)> stalls = [](int, const ArmGoal&, int) { return false; };
   HandInhibit inhibit[2] = {HandInhibit::none, HandInhibit::none};
   bool arm_fault[2] = {false, false};  // the running motion aborts with arm_fault
+  bool refuse_hand_goals[2] = {false, false};  // every hand goal refused (inputs bad)
 
  private:
   struct Arm {
@@ -199,7 +200,9 @@ class Rig {
         }
       }
       Hand& h = hands_[s];
+      if (inhibit[s] != h.st.inhibit && inhibit[s] != HandInhibit::none) ++h.st.inhibits;  // as force_controller
       h.st.inhibit = inhibit[s];
+      h.st.commanding = 1;
       if (h.left > 0 && --h.left == 0) {
         if (h.st.mode == HandMode::force) h.st.settled = 1;
         if (h.st.mode == HandMode::posture) {
@@ -273,6 +276,11 @@ class Rig {
         x.hand_goal = hg;
         sent_.push_back(x);
         Hand& h = hands_[s];
+        if (refuse_hand_goals[s]) {  // as force_controller with bad inputs: refused, counted
+          ++h.st.goals_refused;
+          h.st.last_refusal = static_cast<std::uint8_t>(GoalRefusal::inputs_bad);
+          continue;
+        }
         h.st.goal_id = hg.id;
         h.st.mode = hg.mode;
         ++h.st.goals_accepted;
