@@ -4,8 +4,6 @@
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -15,49 +13,10 @@
 
 namespace crease::vision {
 
-namespace {
-std::string frame_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
+std::string replay_frame_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
   char name[64];
   std::snprintf(name, sizeof name, "/cam%zu/%06" PRIu64 ".png", cam, index);
   return dir + name;
-}
-}  // namespace
-
-ReplaySource::ReplaySource(const std::string& dir) : dir_(dir) {
-  cameras_ = load_camera_dir(dir);
-  const std::string csv = dir + "/timestamps.csv";
-  std::ifstream in(csv);
-  crease::require_input(static_cast<bool>(in), csv + ": cannot read");
-  std::string line;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (lineno == 1 && line.rfind("frame", 0) == 0) continue;  // header
-    if (line.empty()) continue;
-    std::uint64_t f = 0;
-    long long t = 0;
-    char comma = 0;
-    std::istringstream ls(line);
-    crease::require_input(static_cast<bool>(ls >> f >> comma >> t) && comma == ',',
-                          csv + ": line " + std::to_string(lineno) + ": expected 'frame,timestamp_ns'");
-    stamps_.emplace_back(f, static_cast<std::int64_t>(t));
-  }
-}
-
-bool ReplaySource::grab(Frame& frame) {
-  if (next_ >= stamps_.size()) return false;
-  const auto [index, t] = stamps_[next_++];
-  frame.index = index;
-  frame.timestamp_ns = t;
-  frame.images.resize(cameras_.size());
-  for (std::size_t k = 0; k < cameras_.size(); ++k) {
-    const std::string p = frame_path(dir_, k, index);
-    frame.images[k] = std::filesystem::exists(p) ? cv::imread(p, cv::IMREAD_GRAYSCALE) : cv::Mat();
-    const Camera& c = cameras_[k];
-    if (!frame.images[k].empty() && (frame.images[k].cols != c.width || frame.images[k].rows != c.height))
-      frame.images[k] = cv::Mat();  // wrong size: not this camera's image
-  }
-  return true;
 }
 
 namespace {
@@ -190,7 +149,7 @@ Recorder::~Recorder() {
 void Recorder::write(const Frame& frame) {
   for (std::size_t k = 0; k < ncam_ && k < frame.images.size(); ++k) {
     if (frame.images[k].empty()) continue;
-    const std::string p = frame_path(dir_, k, frame.index);
+    const std::string p = replay_frame_path(dir_, k, frame.index);
     if (!cv::imwrite(p, frame.images[k])) throw crease::Error(p + ": write failed");
   }
   std::fprintf(stamps_, "%" PRIu64 ",%" PRId64 "\n", frame.index, frame.timestamp_ns);

@@ -1,9 +1,9 @@
-// Camera sources: N synchronised grey images per frame from a recorded directory or live V4L2
-// devices (the simulated cameras' source, SimSource, is the simulated world's:
+// Camera sources: N synchronised grey images per frame from live V4L2 devices (a recorded
+// directory: replay_source.h; the simulated cameras' source, SimSource, is the simulated world's:
 // plugins/sim_world/scene/sim_source.h), and a recorder writing the replay layout:
 //   DIR/camK.yaml            calibration of camera K (plugins/camera_rig/camera_model.h format)
 //   DIR/camK/NNNNNN.png      frame NNNNNN of camera K (8-bit grey)
-//   DIR/timestamps.csv       "frame,timestamp_ns" header, one line per frame
+//   DIR/timestamps.csv       "frame,timestamp_ns" header, one line per frame (integer ns)
 // A camera that delivers nothing this frame leaves its image empty; the others go on.
 // Not RT code (file and device I/O, OpenCV allocation): run it on a vision worker thread.
 #pragma once
@@ -36,23 +36,13 @@ class CameraSource {
   [[nodiscard]] virtual const std::vector<Camera>& cameras() const = 0;
   // Fills the next frame; false at the end of a recording (or when no camera delivers).
   virtual bool grab(Frame& frame) = 0;
+  // Any thread: asks a grab() that waits (a replay pacing its frames) to return soon, and every
+  // later grab() to return false. The worker calls it before it stops.
+  virtual void cancel() noexcept {}
 };
 
-// Reads a recorded directory. Throws crease::ConfigError naming the file on a missing or bad
-// calibration or timestamps.csv; a missing image is an empty image (that camera stopped).
-class ReplaySource final : public CameraSource {
- public:
-  explicit ReplaySource(const std::string& dir);
-  [[nodiscard]] const std::vector<Camera>& cameras() const override { return cameras_; }
-  bool grab(Frame& frame) override;
-  [[nodiscard]] std::size_t frames() const { return stamps_.size(); }
-
- private:
-  std::string dir_;
-  std::vector<Camera> cameras_;
-  std::vector<std::pair<std::uint64_t, std::int64_t>> stamps_;  // frame index, timestamp
-  std::size_t next_ = 0;
-};
+// DIR/camK/NNNNNN.png: where the replay layout keeps frame `index` of camera `cam`.
+[[nodiscard]] std::string replay_frame_path(const std::string& dir, std::size_t cam, std::uint64_t index);
 
 // How a live camera that did not open, or stopped delivering, is brought back: the capture
 // worker (inside grab()) retries opening it `initial_s` after the failure, doubling the wait

@@ -23,6 +23,7 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
 CameraWorker::~CameraWorker() {
   // Let a frame in flight finish, then stop the thread (also when it waits for the writer end).
   stop_.store(true, std::memory_order_release);
+  source_->cancel();  // a replay waiting for its frame's time returns now
   channel_->wake();
   int s = state_.load(std::memory_order_acquire);
   while (true) {

@@ -4,6 +4,7 @@
 // ThreadSanitizer with OpenCV kept on our threads (own_threads_only), so that TSan checks the
 // RT side against the worker and the hand-over between workers.
 #include "plugins/cameras/camera_worker.h"
+#include "plugins/cameras/replay_source.h"
 
 #include <doctest/doctest.h>
 

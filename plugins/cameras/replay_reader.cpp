@@ -1,0 +1,101 @@
+#include "plugins/cameras/replay_reader.h"
+
+#include <cinttypes>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/assert.h"
+
+namespace crease::vision {
+
+namespace {
+
+// A non-negative decimal integer filling [begin, end) exactly; false on anything else.
+bool parse_uint(const std::string& s, std::size_t begin, std::size_t end, std::uint64_t& out) {
+  if (begin >= end) return false;
+  std::uint64_t v = 0;
+  for (std::size_t i = begin; i < end; ++i) {
+    const char c = s[i];
+    if (c < '0' || c > '9') return false;
+    const auto d = static_cast<std::uint64_t>(c - '0');
+    if (v > (std::numeric_limits<std::uint64_t>::max() - d) / 10) return false;
+    v = v * 10 + d;
+  }
+  out = v;
+  return true;
+}
+
+}  // namespace
+
+std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::string& file) {
+  std::vector<RecordedStamp> out;
+  std::istringstream in(text);
+  std::string line;
+  int lineno = 0;
+  auto fail = [&](const std::string& why) {
+    throw crease::ConfigError(file + ": line " + std::to_string(lineno) + ": " + why);
+  };
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();  // a file written on Windows
+    if (lineno == 1) {
+      if (line != "frame,timestamp_ns")
+        fail("the header must be exactly 'frame,timestamp_ns' (integer nanoseconds), not '" + line + "'");
+      continue;
+    }
+    if (line.empty()) continue;
+    const std::size_t comma = line.find(',');
+    std::uint64_t frame = 0, stamp = 0;
+    if (comma == std::string::npos || !parse_uint(line, 0, comma, frame))
+      fail("expected 'FRAME,TIMESTAMP_NS' with a non-negative integer frame index, not '" + line + "'");
+    if (!parse_uint(line, comma + 1, line.size(), stamp) ||
+        stamp > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+      fail("the timestamp must be a non-negative integer of nanoseconds with nothing after it, not '" +
+           line.substr(comma + 1) + "'");
+    const auto t = static_cast<std::int64_t>(stamp);
+    if (!out.empty() && frame <= out.back().frame)
+      fail("frame " + std::to_string(frame) + " after frame " + std::to_string(out.back().frame) +
+           ": frame indices must increase");
+    if (!out.empty() && t < out.back().stamp_ns)
+      fail("timestamp " + std::to_string(t) + " ns before the previous frame's " +
+           std::to_string(out.back().stamp_ns) + " ns: stamps must not decrease");
+    out.push_back({frame, t});
+  }
+  if (lineno == 0) {
+    lineno = 1;
+    fail("empty file: expected the header 'frame,timestamp_ns'");
+  }
+  return out;
+}
+
+ReplayReader::ReplayReader(const std::string& dir) : dir_(dir) {
+  cameras_ = load_camera_dir(dir);
+  const std::string csv = dir + "/timestamps.csv";
+  std::ifstream in(csv);
+  crease::require_input(static_cast<bool>(in), csv + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  stamps_ = parse_timestamps(text.str(), csv);
+}
+
+void ReplayReader::read(std::size_t i, Frame& frame) const {
+  CREASE_DEMAND(i < stamps_.size(), "ReplayReader::read past the recording's end");
+  const RecordedStamp& s = stamps_[i];
+  frame.index = s.frame;
+  frame.timestamp_ns = s.stamp_ns;
+  frame.images.resize(cameras_.size());
+  for (std::size_t k = 0; k < cameras_.size(); ++k) {
+    const std::string p = replay_frame_path(dir_, k, s.frame);
+    frame.images[k] = std::filesystem::exists(p) ? cv::imread(p, cv::IMREAD_GRAYSCALE) : cv::Mat();
+    const Camera& c = cameras_[k];
+    if (!frame.images[k].empty() && (frame.images[k].cols != c.width || frame.images[k].rows != c.height))
+      frame.images[k] = cv::Mat();  // wrong size: not this camera's image
+  }
+}
+
+}  // namespace crease::vision

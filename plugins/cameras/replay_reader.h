@@ -1,0 +1,48 @@
+// Reads a recorded directory in the replay layout (camera_source.h), frame by frame, as recorded:
+//   DIR/camK.yaml            calibration of camera K
+//   DIR/camK/NNNNNN.png      frame NNNNNN of camera K (8-bit grey); missing = nothing that frame
+//   DIR/timestamps.csv       the header `frame,timestamp_ns`, then one line `INDEX,STAMP` per frame:
+//                            INDEX a non-negative integer greater than the line before's, STAMP
+//                            integer nanoseconds (CLOCK_MONOTONIC of the recording machine), >= 0
+//                            and not decreasing; nothing else on a line
+// Every departure from that (another header, a fraction or seconds, a sign, trailing text, a
+// decreasing stamp, a repeated frame index) is a crease::ConfigError naming the file and line.
+// Not RT (file I/O, PNG decoding, OpenCV allocation). Stateless after construction: read()
+// may be called from one thread at a time for any frame, in any order.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "plugins/camera_rig/camera_model.h"
+#include "plugins/cameras/camera_source.h"
+
+namespace crease::vision {
+
+struct RecordedStamp {
+  std::uint64_t frame = 0;      // the recording's frame index (its PNG file names)
+  std::int64_t stamp_ns = 0;    // the recorded capture time
+};
+
+// Parses a timestamps.csv text; `file` names it in errors ("FILE: line N: reason").
+[[nodiscard]] std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::string& file);
+
+class ReplayReader {
+ public:
+  // Throws crease::ConfigError naming the file on a missing or bad calibration or timestamps.csv.
+  explicit ReplayReader(const std::string& dir);
+  [[nodiscard]] const std::vector<Camera>& cameras() const { return cameras_; }
+  [[nodiscard]] const std::vector<RecordedStamp>& stamps() const { return stamps_; }
+  [[nodiscard]] std::size_t frames() const { return stamps_.size(); }
+  // Decodes recorded frame i (< frames()) into `frame`: fresh images, the recorded index and
+  // stamp. A missing or wrongly sized image is an empty one (that camera delivered nothing).
+  void read(std::size_t i, Frame& frame) const;
+
+ private:
+  std::string dir_;
+  std::vector<Camera> cameras_;
+  std::vector<RecordedStamp> stamps_;
+};
+
+}  // namespace crease::vision

@@ -1,0 +1,114 @@
+#include "plugins/cameras/replay_source.h"
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <utility>
+
+#include "core/assert.h"
+#include "core/errors.h"
+#include "rt/clock.h"
+#include "rt/thread_placement.h"
+
+namespace crease::vision {
+
+ReplaySource::ReplaySource(const std::string& dir, std::size_t read_ahead)
+    : reader_(dir), capacity_(std::max<std::size_t>(read_ahead, 1)) {
+  decoder_ = std::thread([this] { decode_loop(); });
+}
+
+ReplaySource::~ReplaySource() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+    cancelled_ = true;
+  }
+  changed_.notify_all();
+  decoder_.join();
+}
+
+void ReplaySource::cancel() noexcept {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cancelled_ = true;
+  }
+  changed_.notify_all();
+}
+
+void ReplaySource::decode_loop() {
+  crease::rt::place_this_thread_non_rt("crease-replay");
+  for (std::size_t i = 0; i < reader_.frames(); ++i) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [&] { return stop_ || queue_.size() < capacity_; });
+      if (stop_) return;
+    }
+    Frame f;
+    try {
+      reader_.read(i, f);  // outside the lock: the PNG decoding is the slow part
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      error_ = e.what();
+      changed_.notify_all();
+      return;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back(std::move(f));
+    }
+    changed_.notify_all();
+  }
+}
+
+std::size_t ReplaySource::queued() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return queue_.size();
+}
+
+std::int64_t ReplaySource::interval_ns(std::size_t i) const {
+  const auto& s = reader_.stamps();
+  if (i + 1 < s.size()) return s[i + 1].stamp_ns - s[i].stamp_ns;
+  if (i > 0) return s[i].stamp_ns - s[i - 1].stamp_ns;
+  return 0;
+}
+
+bool ReplaySource::grab(Frame& frame) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (cancelled_ || next_ >= reader_.frames()) return false;
+  const auto& stamps = reader_.stamps();
+  std::int64_t start = start_ns_.load(std::memory_order_relaxed);
+  std::int64_t due = start + (stamps[next_].stamp_ns - stamps[0].stamp_ns);
+  if (next_ > 0) {  // not before its time (cancellable: the worker's destructor cancels a wait)
+    const std::chrono::steady_clock::time_point due_tp{std::chrono::nanoseconds(due)};
+    changed_.wait_until(lock, due_tp, [&] { return cancelled_; });
+  }
+  changed_.wait(lock, [&] { return cancelled_ || !queue_.empty() || !error_.empty(); });  // decoded
+  if (!error_.empty() && queue_.empty()) throw crease::Error("replay decoder: " + error_);
+  if (cancelled_) return false;
+  Frame f = std::move(queue_.front());
+  queue_.pop_front();
+  lock.unlock();
+  changed_.notify_all();  // room for the decoder
+
+  const std::int64_t now = crease::rt::now_ns();
+  if (next_ == 0) {  // the replay starts when its first frame is handed out
+    start = due = now;
+    start_ns_.store(start, std::memory_order_release);
+  }
+  const std::int64_t lag = std::max<std::int64_t>(now - due, 0);
+  const std::int64_t interval = interval_ns(next_);
+  if (interval > 0 && lag >= interval) late_.fetch_add(1, std::memory_order_acq_rel);
+  last_lag_ns_.store(lag, std::memory_order_release);
+  if (lag > max_lag_ns_.load(std::memory_order_relaxed)) max_lag_ns_.store(lag, std::memory_order_release);
+  last_delivery_ns_.store(now, std::memory_order_release);
+  ++next_;
+
+  frame.index = f.index;
+  frame.timestamp_ns = due;  // re-based: start + the recorded interval from the first frame
+  frame.images.resize(f.images.size());
+  for (std::size_t k = 0; k < f.images.size(); ++k) frame.images[k] = std::move(f.images[k]);
+  played_.fetch_add(1, std::memory_order_acq_rel);
+  return true;
+}
+
+}  // namespace crease::vision

@@ -1,0 +1,78 @@
+// Plays a recording (replay_reader.h) as a camera source: frames are decoded ahead on a worker
+// thread of its own into a bounded queue, and grab() hands them out at their recorded rate with
+// their time re-based to the replay's start.
+//
+// Time: the replay starts when the first grab() hands out the first frame (CLOCK_MONOTONIC, as
+// everything in the daemon; the camera plugin's first request); that frame is stamped with the
+// start and frame i with start + (t_i - t_0), its recorded interval from the first frame kept. A grab() that comes before its frame is due waits
+// until then (on the calling worker thread, never an RT one); one that comes late, or finds its
+// frame not decoded yet, delivers at once, still stamped with the due time, and counts how far
+// behind the replay is: lag = delivery - due. A frame is late when it was delivered at or after
+// the next frame was due (lag >= its recorded interval to the next frame; the last frame: the
+// interval before it), i.e. the replay could not keep its recorded rate there.
+// Not RT: the counters below are atomics any thread (an RT update too) may read.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "plugins/cameras/camera_source.h"
+#include "plugins/cameras/replay_reader.h"
+
+namespace crease::vision {
+
+class ReplaySource final : public CameraSource {
+ public:
+  static constexpr std::size_t kDefaultReadAhead = 4;  // frame sets decoded ahead (5 x 1.2 MB each)
+  // Reads the directory (throws crease::ConfigError as ReplayReader) and starts decoding ahead,
+  // up to `read_ahead` (>= 1) frames, on a thread named crease-replay on the non-RT CPUs.
+  explicit ReplaySource(const std::string& dir, std::size_t read_ahead = kDefaultReadAhead);
+  ~ReplaySource() override;
+  ReplaySource(const ReplaySource&) = delete;
+  ReplaySource& operator=(const ReplaySource&) = delete;
+
+  [[nodiscard]] const std::vector<Camera>& cameras() const override { return reader_.cameras(); }
+  // The next frame, paced and re-based as above; false after the last one or once cancelled.
+  // Throws crease::Error when the decoder failed.
+  bool grab(Frame& frame) override;
+  void cancel() noexcept override;
+  [[nodiscard]] std::size_t frames() const { return reader_.frames(); }
+  // Frames decoded and not yet handed out (<= read_ahead). Non-RT (takes the queue's lock).
+  [[nodiscard]] std::size_t queued();
+
+  // Progress, any thread. start_ns: when the replay started (0 before the first grab);
+  // last_delivery_ns: when the newest frame was handed out; lags in ns.
+  [[nodiscard]] std::uint64_t played() const noexcept { return played_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::uint64_t late() const noexcept { return late_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t last_lag_ns() const noexcept { return last_lag_ns_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t max_lag_ns() const noexcept { return max_lag_ns_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t start_ns() const noexcept { return start_ns_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t last_delivery_ns() const noexcept {
+    return last_delivery_ns_.load(std::memory_order_acquire);
+  }
+
+ private:
+  void decode_loop();
+  [[nodiscard]] std::int64_t interval_ns(std::size_t i) const;  // recorded interval around frame i
+
+  ReplayReader reader_;
+  std::size_t capacity_;
+  std::mutex mutex_;
+  std::condition_variable changed_;  // queue grew or shrank, or stop/cancel
+  std::deque<Frame> queue_;          // decoded frames, in order, at most capacity_
+  std::string error_;                // the decoder's failure, if any
+  bool stop_ = false;                // the decoder ends (destructor)
+  bool cancelled_ = false;           // grab() returns false from now on
+  std::size_t next_ = 0;             // grab(): the next recorded frame
+  std::atomic<std::uint64_t> played_{0}, late_{0};
+  std::atomic<std::int64_t> last_lag_ns_{0}, max_lag_ns_{0}, start_ns_{0}, last_delivery_ns_{0};
+  std::thread decoder_;  // last: started once everything above exists
+};
+
+}  // namespace crease::vision
