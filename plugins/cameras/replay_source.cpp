@@ -93,18 +93,26 @@ bool ReplaySource::grab(Frame& frame) {
   const std::int64_t now = crease::rt::now_ns();
   if (next_ == 0) {  // the replay starts when its first frame is handed out
     start = due = now;
-    start_ns_.store(start, std::memory_order_release);
+    first_start_ns_ = start;
   }
-  const std::int64_t lag = std::max<std::int64_t>(now - due, 0);
   const std::int64_t interval = interval_ns(next_);
-  if (interval > 0 && lag >= interval) late_.fetch_add(1, std::memory_order_acq_rel);
+  if (interval > 0 && now - due >= interval) {
+    // Late: the next frame was due already. The replay's clock holds back by what it lost, so
+    // this frame is stamped now and the ones after it keep their recorded intervals from here.
+    late_.fetch_add(1, std::memory_order_acq_rel);
+    start += now - due;
+    due = now;
+  }
+  start_ns_.store(start, std::memory_order_release);
+  // Behind the recording: where this frame is handed out against the unbroken recorded timeline.
+  const std::int64_t lag = now - (first_start_ns_ + (stamps[next_].stamp_ns - stamps[0].stamp_ns));
   last_lag_ns_.store(lag, std::memory_order_release);
   if (lag > max_lag_ns_.load(std::memory_order_relaxed)) max_lag_ns_.store(lag, std::memory_order_release);
   last_delivery_ns_.store(now, std::memory_order_release);
   ++next_;
 
   frame.index = f.index;
-  frame.timestamp_ns = due;  // re-based: start + the recorded interval from the first frame
+  frame.timestamp_ns = due;  // re-based: the replay's start + the recorded interval since the first frame
   frame.images.resize(f.images.size());
   for (std::size_t k = 0; k < f.images.size(); ++k) frame.images[k] = std::move(f.images[k]);
   played_.fetch_add(1, std::memory_order_acq_rel);

@@ -4,12 +4,15 @@
 //
 // Time: the replay starts when the first grab() hands out the first frame (CLOCK_MONOTONIC, as
 // everything in the daemon; the camera plugin's first request); that frame is stamped with the
-// start and frame i with start + (t_i - t_0), its recorded interval from the first frame kept. A grab() that comes before its frame is due waits
-// until then (on the calling worker thread, never an RT one); one that comes late, or finds its
-// frame not decoded yet, delivers at once, still stamped with the due time, and counts how far
-// behind the replay is: lag = delivery - due. A frame is late when it was delivered at or after
-// the next frame was due (lag >= its recorded interval to the next frame; the last frame: the
-// interval before it), i.e. the replay could not keep its recorded rate there.
+// start and frame i with start + (t_i - t_0), its recorded interval from the first frame kept.
+// A grab() that comes before its frame is due waits until then (on the calling worker thread,
+// never an RT one). A frame is late when it is handed out at or after the next frame was due
+// (its consumer came late, or its decoding had not finished): the replay could not keep its
+// recorded rate there. A late frame is stamped with the time it is handed out and the replay's
+// start moves by what was lost, so the frames after it keep their recorded intervals from it: a
+// replay that cannot keep up plays slower, never with stamps that fall ever further into the past
+// (a model drops key-points older than its extrapolation horizon). How far behind the recording
+// it is, lag = hand-out time - (first start + t_i - t_0), and the late frames are counted.
 // Not RT: the counters below are atomics any thread (an RT update too) may read.
 #pragma once
 
@@ -46,8 +49,9 @@ class ReplaySource final : public CameraSource {
   // Frames decoded and not yet handed out (<= read_ahead). Non-RT (takes the queue's lock).
   [[nodiscard]] std::size_t queued();
 
-  // Progress, any thread. start_ns: when the replay started (0 before the first grab);
-  // last_delivery_ns: when the newest frame was handed out; lags in ns.
+  // Progress, any thread. start_ns: the replay's start, moved by every late frame (0 before the
+  // first grab); last_delivery_ns: when the newest frame was handed out; lags in ns behind the
+  // recording's timeline (last: of the newest frame).
   [[nodiscard]] std::uint64_t played() const noexcept { return played_.load(std::memory_order_acquire); }
   [[nodiscard]] std::uint64_t late() const noexcept { return late_.load(std::memory_order_acquire); }
   [[nodiscard]] std::int64_t last_lag_ns() const noexcept { return last_lag_ns_.load(std::memory_order_acquire); }
@@ -70,6 +74,7 @@ class ReplaySource final : public CameraSource {
   bool stop_ = false;                // the decoder ends (destructor)
   bool cancelled_ = false;           // grab() returns false from now on
   std::size_t next_ = 0;             // grab(): the next recorded frame
+  std::int64_t first_start_ns_ = 0;  // grab(): when the first frame was handed out
   std::atomic<std::uint64_t> played_{0}, late_{0};
   std::atomic<std::int64_t> last_lag_ns_{0}, max_lag_ns_{0}, start_ns_{0}, last_delivery_ns_{0};
   std::thread decoder_;  // last: started once everything above exists
