@@ -1,12 +1,13 @@
 // Plugin `camera_replay`: plays a recorded directory (replay_source.h, replay layout) into the
 // frame channel at its recorded rate, one frame per request; in lockstep with its reader (the
 // default), so every recorded frame is detected, in order, and the same recording gives the same
-// key-points every time. Frames are decoded ahead (`read_ahead` frame sets) on a thread of the
-// source's own, and stamped with the replay's time: the first frame with the time the plugin
+// key-points every time. Frames are decoded ahead (`read_ahead` frame sets) on `decode_threads`
+// threads of the source's own, and stamped with the replay's time: the first frame with the time the plugin
 // started playing (its first update's request, CLOCK_MONOTONIC), the others their recorded
-// interval after it, so a recording made at any earlier time reaches the model as fresh.
-// Parameters: replay_dir: DIR (its camK.yaml are the cameras), read_ahead (1..64, default 4), and
-// camera_plugin.h's.
+// interval after it, so a recording made at any earlier time reaches the model as fresh (a late
+// frame moves the start: replay_source.h).
+// Parameters: replay_dir: DIR (its camK.yaml are the cameras), read_ahead (1..64, default 4),
+// decode_threads (1..16, default 2), and camera_plugin.h's.
 // Outputs: frames (crease::CameraFrames); replay_lag (Figure: how far behind its recorded time
 // each frame was handed out, ms; 0 when on time) and replay_late (Figure: the share of frames
 // played late, i.e. at or after the next frame was due, %: 100 per late frame, 0 per frame on
@@ -36,7 +37,8 @@ class CameraReplayPlugin final : public CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     const int ahead = p.get_in_range<int>("read_ahead", static_cast<int>(ReplaySource::kDefaultReadAhead), 1, 64);
-    auto src = std::make_unique<ReplaySource>(p.get_path("replay_dir"), static_cast<std::size_t>(ahead));
+    const int decoders = p.get_in_range<int>("decode_threads", ReplaySource::kDefaultDecoders, 1, 16);
+    auto src = std::make_unique<ReplaySource>(p.get_path("replay_dir"), static_cast<std::size_t>(ahead), decoders);
     source_ = src.get();  // owned by the worker, which lives until cleanup()
     lag_ = named_figure("camera_replay lag behind the recording", "ms");
     late_ = named_figure("camera_replay frames played late", "%");
@@ -78,7 +80,7 @@ class CameraReplayPlugin final : public CameraPlugin {
   void deactivate() override {
     CameraPlugin::deactivate();
     const std::uint64_t played = source_->played();
-    const double span_s = static_cast<double>(source_->last_delivery_ns() - source_->start_ns()) * 1e-9;
+    const double span_s = static_cast<double>(source_->last_delivery_ns() - source_->first_start_ns()) * 1e-9;
     std::fprintf(stderr,
                  "camera_replay %s: %llu of %zu frames played, %llu late, lag last %.1f ms, worst %.1f ms, "
                  "%.2f frames/s\n",

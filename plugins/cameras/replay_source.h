@@ -1,6 +1,7 @@
-// Plays a recording (replay_reader.h) as a camera source: frames are decoded ahead on a worker
-// thread of its own into a bounded queue, and grab() hands them out at their recorded rate with
-// their time re-based to the replay's start.
+// Plays a recording (replay_reader.h) as a camera source: frames are decoded ahead on worker
+// threads of its own (each decodes whole frames, the next one not yet claimed) into a bounded
+// window, and grab() hands them out in order, at their recorded rate, with their time re-based
+// to the replay's start.
 //
 // Time: the replay starts when the first grab() hands out the first frame (CLOCK_MONOTONIC, as
 // everything in the daemon; the camera plugin's first request); that frame is stamped with the
@@ -19,7 +20,6 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -33,9 +33,12 @@ namespace crease::vision {
 class ReplaySource final : public CameraSource {
  public:
   static constexpr std::size_t kDefaultReadAhead = 4;  // frame sets decoded ahead (5 x 1.2 MB each)
+  static constexpr int kDefaultDecoders = 2;
   // Reads the directory (throws crease::ConfigError as ReplayReader) and starts decoding ahead,
-  // up to `read_ahead` (>= 1) frames, on a thread named crease-replay on the non-RT CPUs.
-  explicit ReplaySource(const std::string& dir, std::size_t read_ahead = kDefaultReadAhead);
+  // up to `read_ahead` (>= 1) frames not yet handed out, on `decoders` (>= 1) threads named
+  // crease-replay-K on the non-RT CPUs.
+  explicit ReplaySource(const std::string& dir, std::size_t read_ahead = kDefaultReadAhead,
+                        int decoders = kDefaultDecoders);
   ~ReplaySource() override;
   ReplaySource(const ReplaySource&) = delete;
   ReplaySource& operator=(const ReplaySource&) = delete;
@@ -57,27 +60,32 @@ class ReplaySource final : public CameraSource {
   [[nodiscard]] std::int64_t last_lag_ns() const noexcept { return last_lag_ns_.load(std::memory_order_acquire); }
   [[nodiscard]] std::int64_t max_lag_ns() const noexcept { return max_lag_ns_.load(std::memory_order_acquire); }
   [[nodiscard]] std::int64_t start_ns() const noexcept { return start_ns_.load(std::memory_order_acquire); }
+  // When the first frame was handed out (0 before).
+  [[nodiscard]] std::int64_t first_start_ns() const noexcept {
+    return first_start_ns_.load(std::memory_order_acquire);
+  }
   [[nodiscard]] std::int64_t last_delivery_ns() const noexcept {
     return last_delivery_ns_.load(std::memory_order_acquire);
   }
 
  private:
-  void decode_loop();
+  void decode_loop(int k);
   [[nodiscard]] std::int64_t interval_ns(std::size_t i) const;  // recorded interval around frame i
 
   ReplayReader reader_;
   std::size_t capacity_;
   std::mutex mutex_;
-  std::condition_variable changed_;  // queue grew or shrank, or stop/cancel
-  std::deque<Frame> queue_;          // decoded frames, in order, at most capacity_
-  std::string error_;                // the decoder's failure, if any
-  bool stop_ = false;                // the decoder ends (destructor)
+  std::condition_variable changed_;  // a frame decoded or handed out, or stop/cancel
+  std::vector<Frame> slots_;         // frame i in slots_[i % capacity_] while ready_ says so
+  std::vector<char> ready_;
+  std::size_t claimed_ = 0;          // the next frame a decoder takes (< next_ + capacity_)
+  std::string error_;                // a decoder's failure, if any
+  bool stop_ = false;                // the decoders end (destructor)
   bool cancelled_ = false;           // grab() returns false from now on
-  std::size_t next_ = 0;             // grab(): the next recorded frame
-  std::int64_t first_start_ns_ = 0;  // grab(): when the first frame was handed out
+  std::size_t next_ = 0;             // the next recorded frame grab() hands out
   std::atomic<std::uint64_t> played_{0}, late_{0};
-  std::atomic<std::int64_t> last_lag_ns_{0}, max_lag_ns_{0}, start_ns_{0}, last_delivery_ns_{0};
-  std::thread decoder_;  // last: started once everything above exists
+  std::atomic<std::int64_t> last_lag_ns_{0}, max_lag_ns_{0}, start_ns_{0}, first_start_ns_{0}, last_delivery_ns_{0};
+  std::vector<std::thread> decoders_;  // last: started once everything above exists
 };
 
 }  // namespace crease::vision

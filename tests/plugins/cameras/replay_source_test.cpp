@@ -1,6 +1,6 @@
 // ReplaySource: a recording made at any earlier time plays with the replay's time (the first
 // frame stamped with the time of the first grab, the recorded intervals kept), never before a
-// frame is due, decoded ahead on a named non-RT thread into a bounded queue, counting how far
+// frame is due, decoded ahead on named non-RT threads into a bounded window, counting how far
 // behind it is when its consumer comes late, and a wait for a far-off frame ends on cancel().
 #include "plugins/cameras/replay_source.h"
 
@@ -85,8 +85,8 @@ TEST_CASE("a recording made 2000 s ago plays with fresh stamps, its intervals ke
   CHECK(src.played() == 4);
 }
 
-TEST_CASE("frames are decoded ahead on the crease-replay thread, at most read_ahead of them") {
-  ReplaySource src(make_recording("ahead", {0, 1, 2, 3, 4, 5}), 2);
+TEST_CASE("frames are decoded ahead on crease-replay threads, at most read_ahead of them, handed out in order") {
+  ReplaySource src(make_recording("ahead", {0, 1, 2, 3, 4, 5, 6, 7}), 2, 3);
   // The decoder runs without a grab, named, until the queue is full...
   bool full = false;
   for (int i = 0; i < 2000 && !full; ++i) {
@@ -94,13 +94,15 @@ TEST_CASE("frames are decoded ahead on the crease-replay thread, at most read_ah
     if (!full) std::this_thread::sleep_for(2ms);
   }
   REQUIRE(full);
-  CHECK(thread_named("crease-replay"));
+  CHECK(thread_named("crease-replay-0"));
+  CHECK(thread_named("crease-replay-2"));
   std::this_thread::sleep_for(50ms);
   CHECK(src.queued() == 2);  // ...and no further: bounded
   Frame f;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < 8; ++i) {
     REQUIRE(src.grab(f));
-    CHECK(f.index == static_cast<std::uint64_t>(i));  // in order
+    CHECK(f.index == static_cast<std::uint64_t>(i));  // in order, whichever thread decoded it
+    CHECK(f.images[0].at<unsigned char>(0, 0) == 10 * i);
     CHECK(src.queued() <= 2);
   }
   CHECK_FALSE(src.grab(f));
