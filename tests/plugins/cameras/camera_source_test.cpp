@@ -65,9 +65,12 @@ TEST_CASE("a recorded sequence replayed twice gives identical key-points") {
   REQUIRE(ka.size() == kFrames);
   REQUIRE(kb.size() == kFrames);
   for (std::size_t i = 0; i < kFrames; ++i) {
-    // Re-based to each replay's start, the recorded intervals kept.
-    CHECK(ka[i].timestamp_ns - ka[0].timestamp_ns == static_cast<std::int64_t>(i) * 33'333'333);
-    CHECK(kb[i].timestamp_ns - kb[0].timestamp_ns == static_cast<std::int64_t>(i) * 33'333'333);
+    // Stamped with each replay's own time, never closer than recorded (a frame the detection
+    // made late is stamped when handed out: replay_source_test.cpp).
+    if (i > 0) {
+      CHECK(ka[i].timestamp_ns - ka[i - 1].timestamp_ns >= 33'333'333);
+      CHECK(kb[i].timestamp_ns - kb[i - 1].timestamp_ns >= 33'333'333);
+    }
     REQUIRE(ka[i].count == kb[i].count);
     CHECK(ka[i].count > 100);
     CHECK(std::memcmp(ka[i].points, kb[i].points, sizeof(crease::Keypoint) * ka[i].count) == 0);
