@@ -1,5 +1,6 @@
 #include "drivers/can/candump_log.h"
 
+#include <poll.h>
 #include <time.h>
 
 #include <cerrno>
@@ -183,9 +184,26 @@ bool CandumpReader::next(CandumpEntry& out) {
   }
 }
 
-std::size_t replay_candump(CandumpReader& log, CanBus& bus, double speed) {
+namespace {
+void sleep_ns(std::int64_t ns) {
+  timespec t{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+  while (nanosleep(&t, &t) != 0 && errno == EINTR) {
+  }
+}
+// False once the bus's descriptor reports a hang-up or an error (the mock broker is gone,
+// the interface vanished).
+bool bus_alive(const CanBus& bus) {
+  if (bus.fd() < 0) return true;
+  pollfd p{bus.fd(), 0, 0};
+  return ::poll(&p, 1, 0) <= 0 || (p.revents & (POLLHUP | POLLERR | POLLNVAL)) == 0;
+}
+}  // namespace
+
+std::size_t replay_candump(CandumpReader& log, CanBus& bus, double speed, ReplayStats* stats,
+                           void (*pause_ns)(std::int64_t)) {
+  if (!pause_ns) pause_ns = sleep_ns;
   CandumpEntry e;
-  std::size_t sent = 0;
+  ReplayStats st;
   std::int64_t first_log = -1, first_wall = 0;
   while (log.next(e)) {
     if (e.frame.is_error()) continue;  // error frames are bus events, not something to send
@@ -199,19 +217,23 @@ std::size_t replay_candump(CandumpReader& log, CanBus& bus, double speed) {
       while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
       }
     }
-    for (int tries = 0;; ++tries) {
+    for (std::int64_t backoff = 20'000;;) {
       const SendResult r = bus.send(e.frame);
       if (r == SendResult::ok) break;
-      if (r != SendResult::no_buffers || tries > 100000) {
-        throw std::runtime_error("candump replay: bus refused frame " + std::to_string(sent) +
-                                 " (" + std::strerror(bus.errno_value()) + ")");
+      if (r != SendResult::no_buffers || !bus_alive(bus)) {
+        const char* why = r == SendResult::bus_off ? "bus-off" : r == SendResult::no_buffers ? "the bus is gone" : "send failed";
+        throw std::runtime_error("candump replay: bus refused frame " + std::to_string(st.sent) + " (" + why + ": " +
+                                 std::strerror(bus.errno_value()) + ")");
       }
-      timespec pause{0, 50'000};
-      nanosleep(&pause, nullptr);
+      ++st.waits;
+      pause_ns(backoff);
+      backoff = backoff < 1'000'000 ? 2 * backoff : 1'000'000;
     }
-    ++sent;
+    ++st.sent;
+    if (stats) *stats = st;
   }
-  return sent;
+  if (stats) *stats = st;
+  return st.sent;
 }
 
 }  // namespace crease::drivers

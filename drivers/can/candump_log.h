@@ -55,8 +55,18 @@ class CandumpReader {
   int line_ = 0;
 };
 
-// Replays a log onto a bus, keeping the recorded inter-frame gaps scaled by 1/speed
-// (speed <= 0: as fast as the bus accepts). Retries on no_buffers. Returns frames sent.
-std::size_t replay_candump(CandumpReader& log, CanBus& bus, double speed);
+struct ReplayStats {
+  std::size_t sent = 0;
+  std::uint64_t waits = 0;  // pauses for room on the bus (a no_buffers answer each)
+};
+
+// Replays a log onto a bus, keeping the recorded inter-frame gaps (from the first frame)
+// scaled by 1/speed (speed <= 0: as fast as the bus takes them). A full transmit queue
+// (no_buffers) is waited out, however long it lasts, pausing 20 us doubling to 1 ms between
+// tries; the replay gives up only if the bus is gone (its fd hung up or failed) or bus-off
+// or broken (std::runtime_error naming the frame). `pause_ns` is how it pauses (nullptr:
+// nanosleep), for tests. Returns frames sent.
+std::size_t replay_candump(CandumpReader& log, CanBus& bus, double speed, ReplayStats* stats = nullptr,
+                           void (*pause_ns)(std::int64_t) = nullptr);
 
 }  // namespace crease::drivers

@@ -1,8 +1,10 @@
 #include "drivers/can/candump_log.h"
 
 #include <doctest/doctest.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -175,5 +177,74 @@ TEST_CASE("a log replays onto a mock bus in order") {
     }
   }
   CHECK(got == entries.size());
+  std::remove(path.c_str());
+}
+
+namespace {
+// A bus whose transmit queue stays full for a long stretch (a reader that holds the bus up):
+// it refuses frame `stall_at` for `refusals` tries, far beyond any fixed retry budget.
+class StallingBus final : public CanBus {
+ public:
+  StallingBus(std::size_t stall_at, std::uint64_t refusals, int fd) : stall_at_(stall_at), refusals_(refusals), fd_(fd) {}
+  SendResult send(const CanFrame& f) noexcept override {
+    if (sent.size() == stall_at_ && refused < refusals_) {
+      ++refused;
+      return SendResult::no_buffers;
+    }
+    sent.push_back(f);
+    return SendResult::ok;
+  }
+  RecvResult try_receive(RxFrame&) noexcept override { return RecvResult::empty; }
+  int fd() const noexcept override { return fd_; }
+  BusState state() const noexcept override { return BusState::error_active; }
+  void restart() noexcept override {}
+  const CanBusCounters& counters() const noexcept override { return counters_; }
+  int errno_value() const noexcept override { return ENOBUFS; }
+  std::vector<CanFrame> sent;
+  std::uint64_t refused = 0;
+
+ private:
+  std::size_t stall_at_;
+  std::uint64_t refusals_;
+  int fd_;
+  CanBusCounters counters_;
+};
+
+std::uint64_t g_pauses = 0;
+void count_pause(std::int64_t) { ++g_pauses; }  // the replay's pause, without the wait
+}  // namespace
+
+TEST_CASE("a replay waits out a full transmit queue however long it lasts, and stops when the bus is gone") {
+  const std::string path = tmp_path("stall.log");
+  const auto entries = sample_entries();
+  {
+    CandumpWriter w(path);
+    for (const auto& e : entries) w.write(e);
+  }
+  int sv[2];
+  REQUIRE(::socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv) == 0);
+  // The old replay gave up after 100,001 refusals ("bus refused frame N (No buffer space
+  // available)"); a bus that stays full for 300,000 tries must still get every frame.
+  StallingBus bus(17, 300'000, sv[0]);
+  g_pauses = 0;
+  ReplayStats st;
+  {
+    CandumpReader r(path);
+    CHECK(replay_candump(r, bus, 0.0, &st, count_pause) == entries.size());
+  }
+  CHECK(bus.refused == 300'000);
+  CHECK(st.waits == 300'000);
+  CHECK(g_pauses == 300'000);
+  REQUIRE(bus.sent.size() == entries.size());
+  for (std::size_t i = 0; i < entries.size(); ++i) CHECK(bus.sent[i] == entries[i].frame);
+
+  // The bus's other end hangs up while its queue is full: the replay names the frame and stops.
+  ::close(sv[1]);
+  StallingBus gone(5, ~std::uint64_t{0}, sv[0]);
+  CandumpReader r(path);
+  CHECK_THROWS_WITH_AS(replay_candump(r, gone, 0.0, &st, count_pause), doctest::Contains("frame 5 (the bus is gone"),
+                       std::runtime_error);
+  CHECK(gone.sent.size() == 5);
+  ::close(sv[0]);
   std::remove(path.c_str());
 }
