@@ -14,6 +14,21 @@ RecordingCanBus::RecordingCanBus(CanBus& inner, const std::string& interface, st
     throw std::invalid_argument("recording CAN bus: interface name '" + interface + "' must be 1..15 characters");
   }
   std::memcpy(interface_, interface.data(), interface.size());
+  // The offset between the clocks, read between two monotonic reads (the tightest pair of
+  // three tries), so it is off by at most the time of one clock read.
+  std::int64_t best = -1;
+  for (int i = 0; i < 3; ++i) {
+    timespec a{}, w{}, b{};
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    clock_gettime(CLOCK_REALTIME, &w);
+    clock_gettime(CLOCK_MONOTONIC, &b);
+    const auto ns = [](const timespec& t) { return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec; };
+    const std::int64_t span = ns(b) - ns(a);
+    if (best < 0 || span < best) {
+      best = span;
+      epoch_offset_ns_ = ns(w) - (ns(a) + span / 2);
+    }
+  }
 }
 
 void RecordingCanBus::record(const CanFrame& f, std::int64_t ts) noexcept {
@@ -53,7 +68,9 @@ std::size_t RecordingCanBus::drain_to(CandumpWriter& log) {
   std::size_t n = 0;
   std::size_t tail = tail_.load(std::memory_order_relaxed);
   while (tail != head_.load(std::memory_order_acquire)) {
-    log.write(ring_[tail]);
+    CandumpEntry e = ring_[tail];
+    e.timestamp_ns += epoch_offset_ns_;
+    log.write(e);
     tail = (tail + 1) % ring_.size();
     tail_.store(tail, std::memory_order_release);
     ++n;

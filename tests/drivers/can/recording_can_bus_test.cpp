@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 #include <poll.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include "drivers/can/mock_can_broker.h"
 #include "drivers/can/mock_can_bus.h"
 #include "rt/alloc_guard.h"
+#include "rt/clock.h"
 
 using namespace crease::drivers;
 
@@ -76,4 +78,46 @@ TEST_CASE("a full ring drops and counts instead of blocking") {
   RecordingCanBus a(a_raw, "can0", 8);
   for (int i = 0; i < 20; ++i) REQUIRE(a.send(CanFrame::classic(0x10, {})) == SendResult::ok);
   CHECK(a.dropped() == 13);  // capacity 8 holds 7
+}
+
+namespace {
+std::int64_t wall_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_REALTIME, &t);
+  return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec;
+}
+}  // namespace
+
+TEST_CASE("a recording is stamped in wall-clock epoch time, as candump -L, with the monotonic intervals") {
+  const std::string name = "rec3-" + std::to_string(::getpid());
+  MockCanBroker broker({name, 0, 0, false});
+  MockCanBus raw({name, 1, 0, 0});
+  const std::int64_t wall_before = wall_ns();
+  RecordingCanBus a(raw, "can0");
+  std::int64_t mono[3];
+  for (int i = 0; i < 3; ++i) {
+    REQUIRE(a.send(CanFrame::classic(0x100 + static_cast<std::uint32_t>(i), {})) == SendResult::ok);
+    mono[i] = crease::rt::now_ns();  // just after the record's stamp
+    ::usleep(3000);
+  }
+  const std::int64_t wall_after = wall_ns();
+  const std::string path = "/tmp/crease_rec3_" + std::to_string(::getpid()) + ".log";
+  {
+    CandumpWriter w(path);
+    REQUIRE(a.drain_to(w) == 3);
+  }
+  CandumpReader r(path);
+  CandumpEntry e[3];
+  for (auto& x : e) REQUIRE(r.next(x));
+  // Wall clock: between the clock before and after (the log's microseconds round down). A
+  // monotonic stamp (time since boot) is decades before wall_before.
+  CHECK(e[0].timestamp_ns >= wall_before - 1000);
+  CHECK(e[2].timestamp_ns <= wall_after);
+  // The intervals are the monotonic ones: each stamp minus the offset is a monotonic time at
+  // or before the read that followed the send (to the microsecond of the log).
+  for (int i = 0; i < 3; ++i) {
+    CHECK(e[i].timestamp_ns - a.epoch_offset_ns() <= mono[i]);
+    if (i > 0) CHECK(e[i].timestamp_ns - a.epoch_offset_ns() > mono[i - 1] - 1000);
+  }
+  std::remove(path.c_str());
 }
