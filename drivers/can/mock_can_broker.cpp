@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <memory>
@@ -18,6 +19,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "drivers/can/mock_access.h"
 #include "drivers/can/mock_reactor.h"
 #include "drivers/can/mock_wire.h"
 
@@ -38,6 +40,7 @@ constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
 // The broker's state; the process's reactor thread drives it (mockwire::BrokerCore).
 struct MockCanBroker::Impl final : mockwire::BrokerCore {
   MockCanBrokerConfig cfg;
+  mockwire::BusAccess access;
   std::shared_ptr<mockwire::Reactor> reactor;
   int listen_fd = -1;
 
@@ -199,10 +202,28 @@ struct MockCanBroker::Impl final : mockwire::BrokerCore {
   }
 
   // --- sockets ----------------------------------------------------------------------------
+  // A node of another user: told so, hung up on, counted and logged (the first 20 refusals,
+  // then every 1000th, so a refused peer cannot flood the log).
+  void refuse(int fd, const mockwire::PeerCred& who) {
+    Record r;
+    r.kind = mockwire::kRefused;
+    (void)mockwire::send_record(fd, r, nullptr, 0, MSG_DONTWAIT);
+    ::close(fd);
+    const std::uint64_t n = ++stats.refused;
+    if (n <= 20 || n % 1000 == 0) {
+      std::fprintf(stderr, "crease: mock CAN bus '%s': refused connection %llu: %s\n", cfg.name.c_str(),
+                   static_cast<unsigned long long>(n), mockwire::describe_refusal(who, access).c_str());
+    }
+  }
   void accept_all() {
     for (;;) {
       const int c = ::accept4(listen_fd, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
       if (c < 0) break;
+      mockwire::PeerCred who;
+      if (!mockwire::peer_allowed(c, access, who)) {
+        refuse(c, who);
+        continue;
+      }
       clients.push_back(std::make_unique<Client>());
       clients.back()->fd = c;
       reactor->watch_locked(this, c);
@@ -385,6 +406,12 @@ struct MockCanBroker::Impl final : mockwire::BrokerCore {
 
 MockCanBroker::MockCanBroker(MockCanBrokerConfig cfg) : cfg_(std::move(cfg)), impl_(new Impl) {
   impl_->cfg = cfg_;
+  try {
+    impl_->access = mockwire::make_bus_access(cfg_.group);
+  } catch (...) {
+    delete impl_;
+    throw;
+  }
   sockaddr_un addr{};
   socklen_t len = 0;
   try {

@@ -1,5 +1,6 @@
 // MockCanBroker: the medium of a user-space CAN bus. Nodes (MockCanBus, in this process or
-// another) connect to it by bus name over AF_UNIX SOCK_SEQPACKET; the broker forwards every
+// another) connect to it by bus name over AF_UNIX SOCK_SEQPACKET (only processes of the same
+// user, root or the configured group: others are refused, counted and logged to stderr); the broker forwards every
 // frame to every other node, timestamps it with a bit-timed bus-load model (a virtual bus
 // clock at the configured bitrates) and injects seeded faults. Frames travel through
 // shared-memory rings (mock_wire.h); one (non-RT) thread per process serves every broker of
@@ -30,6 +31,9 @@ struct MockCanBrokerConfig {
   std::uint32_t nominal_bps = 1'000'000;  // arbitration bitrate; 0 = no bus-time model
   std::uint32_t data_bps = 5'000'000;     // FD data-phase bitrate
   bool pace = false;  // deliver frames only when the virtual bus has finished sending them
+  // Besides this process's user (and root), members of this group may join (mock_access.h);
+  // empty: the environment variable CREASE_CAN_GROUP, or nobody else.
+  std::string group;
 };
 
 struct MockCanBrokerStats {
@@ -38,13 +42,14 @@ struct MockCanBrokerStats {
   std::uint64_t dropped_fault = 0; // by drop fault, silent node or bus-off sender
   std::uint64_t rx_overflow = 0;   // a node's receive queue was full
   std::int64_t busy_ns = 0;        // virtual bus time used
+  std::uint64_t refused = 0;       // connections refused: another user, not in the bus's group
   int nodes = 0;
 };
 
 class MockCanBroker {
  public:
   // Binds the bus name and joins the process's broker thread. Throws std::runtime_error naming the bus
-  // if the name is taken or a socket call fails.
+  // if the name is taken or a socket call fails, std::invalid_argument for an unknown group.
   explicit MockCanBroker(MockCanBrokerConfig cfg);
   ~MockCanBroker();
   MockCanBroker(const MockCanBroker&) = delete;

@@ -2,6 +2,7 @@
 
 #include <poll.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "drivers/can/mock_access.h"
 #include "drivers/can/mock_wire.h"
 #include "rt/clock.h"
 
@@ -22,16 +24,24 @@ MockCanBus::MockCanBus(MockCanBusConfig cfg) : cfg_(std::move(cfg)) {
     close_all();
     throw std::runtime_error("mock CAN bus '" + cfg_.bus + "': " + what + " (" + std::strerror(e) + ")");
   };
+  const mockwire::BusAccess access = mockwire::make_bus_access(cfg_.group);
   sockaddr_un addr{};
   const socklen_t len = mockwire::make_address(cfg_.bus, addr);
   fd_ = ::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
   if (fd_ < 0) fail("socket", errno);
   if (::connect(fd_, reinterpret_cast<sockaddr*>(&addr), len) != 0) fail("no broker", errno);
+  // Anyone may bind a free abstract name: join only a broker of a user this node trusts.
+  mockwire::PeerCred broker;
+  if (!mockwire::peer_allowed(fd_, access, broker)) {
+    close_all();
+    throw std::runtime_error("mock CAN bus '" + cfg_.bus + "': not joining a broker of another user: " +
+                             mockwire::describe_refusal(broker, access));
+  }
   // The shared segment: created here, handed to the broker with the hello.
   const int shm_fd = ::memfd_create("crease-can-node", MFD_CLOEXEC);
   if (shm_fd < 0) fail("memfd_create", errno);
   void* p = MAP_FAILED;
-  if (::ftruncate(shm_fd, sizeof(mockwire::NodeShm)) == 0) {
+  if (::fchmod(shm_fd, 0600) == 0 && ::ftruncate(shm_fd, sizeof(mockwire::NodeShm)) == 0) {
     p = ::mmap(nullptr, sizeof(mockwire::NodeShm), PROT_READ | PROT_WRITE, MAP_SHARED, shm_fd, 0);
   }
   if (p == MAP_FAILED) {
@@ -46,14 +56,31 @@ MockCanBus::MockCanBus(MockCanBusConfig cfg) : cfg_(std::move(cfg)) {
   const ssize_t sent = mockwire::send_record(fd_, hello, &shm_fd, 1, 0);
   const int send_errno = errno;
   ::close(shm_fd);
-  if (sent != sizeof(hello)) fail("hello", send_errno);
+  if (sent != sizeof(hello)) {
+    // A broker that refused this node may have hung up before the hello: its answer waits.
+    mockwire::Record answer;
+    int afds[mockwire::kMaxFds];
+    ssize_t got = mockwire::recv_record(fd_, answer, afds, MSG_DONTWAIT);
+    if (got < 0 && errno == ECONNRESET) got = mockwire::recv_record(fd_, answer, afds, MSG_DONTWAIT);
+    const bool refused = got == sizeof(answer) && answer.kind == mockwire::kRefused;
+    for (int fd : afds) {
+      if (fd >= 0) ::close(fd);
+    }
+    if (refused) fail("the broker refuses this user (another user's bus; see its group)", EACCES);
+    fail("hello", send_errno);
+  }
   // The welcome: the broker thread's eventfd and its page.
   pollfd pfd{fd_, POLLIN, 0};
   if (::poll(&pfd, 1, 5000) <= 0) fail("no welcome from the broker", ETIMEDOUT);
   mockwire::Record welcome;
   int fds[mockwire::kMaxFds];
-  const ssize_t got = mockwire::recv_record(fd_, welcome, fds, 0);
+  ssize_t got = mockwire::recv_record(fd_, welcome, fds, 0);
+  // A broker that hung up on an unread hello leaves ECONNRESET, reported before its answer.
+  if (got < 0 && errno == ECONNRESET) got = mockwire::recv_record(fd_, welcome, fds, MSG_DONTWAIT);
   const int recv_errno = errno;
+  if (got == sizeof(welcome) && welcome.kind == mockwire::kRefused) {
+    fail("the broker refuses this user (another user's bus; see its group)", EACCES);
+  }
   if (got != sizeof(welcome) || welcome.kind != mockwire::kWelcome || fds[0] < 0 || fds[1] < 0) {
     for (int fd : fds) {
       if (fd >= 0) ::close(fd);

@@ -28,13 +28,17 @@ struct MockCanBusConfig {
   std::uint32_t node_id = 0;              // identifies this node to the broker (faults, bus-off)
   std::uint32_t nominal_bps = 1'000'000;  // for the tx queue model; 0 = unlimited
   std::uint32_t data_bps = 5'000'000;
+  // Besides this process's user (and root), a broker run by a member of this group is
+  // trusted (mock_access.h); empty: the environment variable CREASE_CAN_GROUP, or nobody else.
+  std::string group;
 };
 
 class MockCanBus final : public CanBus {
  public:
   static constexpr int kTxQueueLen = 10;  // Linux default txqueuelen of a CAN netdev
 
-  // Connects to the broker. Throws std::runtime_error naming the bus if none serves it.
+  // Connects to the broker. Throws std::runtime_error naming the bus if none serves it, if the
+  // broker runs as a user this node does not trust, or if the broker refuses this node's user.
   explicit MockCanBus(MockCanBusConfig cfg);
   ~MockCanBus() override;
   MockCanBus(const MockCanBus&) = delete;

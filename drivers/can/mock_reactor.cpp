@@ -6,6 +6,7 @@
 #include <sys/eventfd.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -53,7 +54,7 @@ Reactor::Reactor() {
   if (epoll_fd_ < 0) fail("epoll_create1");
   doorbell_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   page_fd_ = ::memfd_create("crease-can-reactor", MFD_CLOEXEC);
-  if (doorbell_fd_ < 0 || page_fd_ < 0 || ::ftruncate(page_fd_, 4096) != 0) {
+  if (doorbell_fd_ < 0 || page_fd_ < 0 || ::fchmod(page_fd_, 0600) != 0 || ::ftruncate(page_fd_, 4096) != 0) {
     const int e = errno;
     for (int fd : {epoll_fd_, doorbell_fd_, page_fd_}) {
       if (fd >= 0) ::close(fd);

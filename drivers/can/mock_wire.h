@@ -8,6 +8,8 @@
 // hello (with the memfd), the broker's welcome (with its eventfd and ReactorShm memfd) and
 // 1-byte doorbells that make the node's socket readable when `rx` got records while
 // `rx_signalled` was 0. Its hang-up tells either side that the other is gone.
+// Access: the broker checks each connecting node's credentials before anything else, and the
+// node checks the broker's (mock_access.h); a refused node gets kRefused and a hang-up.
 #pragma once
 
 #include <sys/socket.h>
@@ -26,6 +28,7 @@ enum Kind : std::uint32_t {
   kHello = 1,    // node -> broker (socket, with the NodeShm memfd): frame.can_id = node id
   kRestart = 2,  // node -> broker (tx ring): leave bus-off
   kWelcome = 3,  // broker -> node (socket, with its eventfd and ReactorShm memfd)
+  kRefused = 4,  // broker -> node (socket): the node's user may not use this bus (then hang-up)
 };
 
 struct Record {
