@@ -151,6 +151,17 @@ void SocketcandBridge::run() {
             case socketcand::Command::send:
               if (c.raw) {
                 ++from_clients_;
+                // As on a socketcand server (one raw socket per client, loopback on): every
+                // other client of the bus sees the frame, the sender does not.
+                char line[96];
+                const std::size_t n = socketcand::format_frame(m.frame, now, line, sizeof(line));
+                for (std::size_t j = 0; j < clients.size() && n > 0; ++j) {
+                  Client& o = clients[j];
+                  if (j != k && o.raw && now - o.raw_since_ns >= kRawmodeGraceNs) {
+                    o.out.append(line, n);
+                    ++to_clients_;
+                  }
+                }
                 if (!pending_tx.empty() || bus_.send(m.frame) == SendResult::no_buffers) {
                   pending_tx.push_back(m.frame);
                   ++nobufs_;

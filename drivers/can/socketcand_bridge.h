@@ -1,6 +1,8 @@
 // SocketcandBridge: a socketcand server on 127.0.0.1 for one CAN bus (rawmode, classic frames),
 // so python-can ("socketcand" interface) and other socketcand clients can watch and inject
-// frames. Runs its own (non-RT) thread and is the only user of `bus` while it runs.
+// frames. Runs its own (non-RT) thread and is the only user of `bus` while it runs. A client's
+// frames go onto the bus and to every other client in rawmode (as socketcand's per-client
+// raw sockets see each other's frames); the sender does not get its own back.
 // FD and error frames are not forwarded (socketcand rawmode is classic only); they are counted.
 #pragma once
 

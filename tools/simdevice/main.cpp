@@ -6,8 +6,11 @@
 //   crease-simdevice arm     --bus NAME --node N
 //   crease-simdevice tactile             (creates a pty, prints "pty: /dev/pts/N", serves it)
 //   crease-simdevice record  --bus NAME --out FILE.log [--node N]   (candump -L log of the bus)
-//   crease-simdevice replay  --bus NAME --in FILE.log [--speed X]   (X <= 0: as fast as possible)
-//   common: [--seconds S] (default: until SIGINT/SIGTERM) [--silent-after S --silent-for S]
+//   crease-simdevice replay  --bus NAME --in FILE.log [--speed X]   (X <= 0: as fast as the bus takes)
+//   crease-simdevice socketcand --bus NAME [--listen 127.0.0.1:PORT] [--interface can0] [--node N]
+//                            (a socketcand server for the bus; PORT 0: any, printed as "socketcand: HOST:PORT")
+//   common: [--group G] (members of group G may use the bus too; default $CREASE_CAN_GROUP)
+//           [--seconds S] (default: until SIGINT/SIGTERM) [--silent-after S --silent-for S]
 //           [--fifo PRIO] (run under SCHED_FIFO where permitted, like a device's firmware)
 // Exit status 0 on a clean stop; 2 on a usage error (the message names the option).
 #include <poll.h>
@@ -28,6 +31,7 @@
 #include "drivers/can/candump_log.h"
 #include "drivers/can/mock_can_bus.h"
 #include "drivers/can/recording_can_bus.h"
+#include "drivers/can/socketcand_bridge.h"
 #include "drivers/serial/serial_port.h"
 #include "drivers/simdevice/sim_arm.h"
 #include "drivers/simdevice/sim_hand.h"
@@ -61,7 +65,7 @@ struct Args {
 };
 
 Args parse(int argc, char** argv) {
-  if (argc < 2) throw std::invalid_argument("missing mode (broker, hand, arm, tactile, record, replay)");
+  if (argc < 2) throw std::invalid_argument("missing mode (broker, hand, arm, tactile, record, replay, socketcand)");
   Args a;
   a.mode = argv[1];
   for (int i = 2; i < argc; ++i) {
@@ -110,7 +114,23 @@ int serve_can_device(const Args& a, const MockCanBus& bus, sim::CanopenDevice& d
 MockCanBusConfig bus_config(const Args& a, std::uint32_t node) {
   if (!a.has("bus")) throw std::invalid_argument("option --bus is required");
   return {a.str("bus"), node, static_cast<std::uint32_t>(a.num("bitrate", 1'000'000)),
-          static_cast<std::uint32_t>(a.num("data-bitrate", 5'000'000))};
+          static_cast<std::uint32_t>(a.num("data-bitrate", 5'000'000)), a.str("group")};
+}
+
+// "127.0.0.1:PORT" or "localhost:PORT" (the bridge serves the loopback interface only).
+std::uint16_t listen_port(const std::string& v) {
+  const std::size_t colon = v.rfind(':');
+  const std::string host = colon == std::string::npos ? "" : v.substr(0, colon);
+  const std::string port = colon == std::string::npos ? v : v.substr(colon + 1);
+  if (host != "127.0.0.1" && host != "localhost") {
+    throw std::invalid_argument("option --listen: '" + v + "' must be 127.0.0.1:PORT (the bridge serves loopback only)");
+  }
+  char* end = nullptr;
+  const long p = std::strtol(port.c_str(), &end, 10);
+  if (port.empty() || *end != '\0' || p < 0 || p > 65535) {
+    throw std::invalid_argument("option --listen: '" + port + "' is not a port (0..65535)");
+  }
+  return static_cast<std::uint16_t>(p);
 }
 
 std::uint8_t node_of(const Args& a) {
@@ -132,7 +152,8 @@ int run(const Args& a) {
   if (a.mode == "broker") {
     if (!a.has("bus")) throw std::invalid_argument("option --bus is required");
     MockCanBrokerConfig cfg{a.str("bus"), static_cast<std::uint32_t>(a.num("bitrate", 1'000'000)),
-                            static_cast<std::uint32_t>(a.num("data-bitrate", 5'000'000)), a.has("pace")};
+                            static_cast<std::uint32_t>(a.num("data-bitrate", 5'000'000)), a.has("pace"),
+                            a.str("group")};
     CanFaultConfig f;
     f.seed = static_cast<std::uint64_t>(a.num("seed", 1));
     f.drop = a.num("drop", 0);
@@ -188,9 +209,14 @@ int run(const Args& a) {
         [&](std::int64_t) {
           while (rec.try_receive(rx) != RecvResult::empty) {
           }
-          lines += rec.drain_to(log);
+          if (const std::size_t n = rec.drain_to(log); n > 0) {
+            lines += n;
+            log.flush();  // the log is readable while it grows (tail -f, tests)
+          }
         },
         [](bool) {});
+    while (rec.try_receive(rx) != RecvResult::empty) {  // what arrived before the stop
+    }
     lines += rec.drain_to(log);
     log.flush();
     std::fprintf(stderr, "crease-simdevice: recorded %zu frames (%llu dropped)\n", lines,
@@ -205,7 +231,21 @@ int run(const Args& a) {
     std::fprintf(stderr, "crease-simdevice: replayed %zu frames\n", n);
     return 0;
   }
-  throw std::invalid_argument("unknown mode '" + a.mode + "' (broker, hand, arm, tactile, record, replay)");
+  if (a.mode == "socketcand") {
+    const std::uint16_t port = listen_port(a.str("listen", "127.0.0.1:29536"));
+    MockCanBus bus(bus_config(a, static_cast<std::uint32_t>(a.num("node", 125))));
+    SocketcandBridge bridge(bus, port, a.str("interface", "can0"));
+    std::printf("socketcand: 127.0.0.1:%u\n", static_cast<unsigned>(bridge.port()));
+    std::fflush(stdout);
+    const std::int64_t t0 = crease::rt::now_ns();
+    const double seconds = a.num("seconds", 0);
+    while (!g_stop && (seconds <= 0 || static_cast<double>(crease::rt::now_ns() - t0) * 1e-9 < seconds)) ::usleep(10'000);
+    const SocketcandBridgeStats st = bridge.stats();
+    std::fprintf(stderr, "crease-simdevice: socketcand: %llu frames to clients, %llu from clients\n",
+                 static_cast<unsigned long long>(st.to_clients), static_cast<unsigned long long>(st.from_clients));
+    return 0;
+  }
+  throw std::invalid_argument("unknown mode '" + a.mode + "' (broker, hand, arm, tactile, record, replay, socketcand)");
 }
 }  // namespace
 
