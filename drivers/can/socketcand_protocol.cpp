@@ -38,6 +38,7 @@ bool parse_hex(std::string_view t, std::uint32_t max_digits, std::uint32_t* out)
 
 bool parse_message(std::string_view s, Message& out) noexcept {
   out = Message{};
+  if (s.size() > kMaxMessage) return false;  // longer than any message (StreamSplitter drops those)
   while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
   while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
   if (s.size() < 3 || s.front() != '<' || s.back() != '>') return false;
@@ -117,25 +118,33 @@ std::size_t format_frame(const CanFrame& f, std::int64_t ts, char* buf, std::siz
 }
 
 std::size_t StreamSplitter::feed(const char* data, std::size_t n, const char** msg, std::size_t* len) noexcept {
+  // Run by run: memchr finds the next '<' (outside a message) or '>' (inside one).
   *msg = nullptr;
   *len = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const char c = data[i];
+  std::size_t i = 0;
+  while (i < n) {
     if (!in_message_) {
-      if (c == '<') {
-        in_message_ = true;
-        overflow_ = false;
-        n_ = 0;
-        buf_[n_++] = c;
-      }
+      const auto* lt = static_cast<const char*>(std::memchr(data + i, '<', n - i));
+      if (!lt) return n;
+      i = static_cast<std::size_t>(lt - data) + 1;
+      in_message_ = true;
+      overflow_ = false;
+      buf_[0] = '<';
+      n_ = 1;
       continue;
     }
-    if (n_ < sizeof(buf_)) {
-      buf_[n_++] = c;
+    const auto* gt = static_cast<const char*>(std::memchr(data + i, '>', n - i));
+    const std::size_t end = gt ? static_cast<std::size_t>(gt - data) + 1 : n;  // [i, end) is message
+    const std::size_t k = end - i, room = sizeof(buf_) - n_;
+    std::memcpy(buf_ + n_, data + i, k <= room ? k : room);
+    if (k <= room) {
+      n_ += k;
     } else {
+      n_ = sizeof(buf_);
       overflow_ = true;
     }
-    if (c == '>') {
+    i = end;
+    if (gt) {
       in_message_ = false;
       if (overflow_) {
         ++dropped_;
@@ -143,7 +152,7 @@ std::size_t StreamSplitter::feed(const char* data, std::size_t n, const char** m
       }
       *msg = buf_;
       *len = n_;
-      return i + 1;
+      return i;
     }
   }
   return n;

@@ -24,7 +24,7 @@ struct Message {
 };
 
 // Parses one complete message "< ... >" (surrounding whitespace allowed). False if malformed
-// (unknown words give Command::unknown and true).
+// or longer than kMaxMessage (unknown words give Command::unknown and true).
 [[nodiscard]] bool parse_message(std::string_view text, Message& out) noexcept;
 
 // Formats "< frame ID SEC.USEC HEXDATA >" for a classic frame; returns length, 0 if it does

@@ -29,10 +29,17 @@ long cobs_decode(std::span<const std::uint8_t> in, std::span<std::uint8_t> out) 
   while (i < in.size()) {
     const std::uint8_t code = in[i++];
     if (code == 0) return -1;
-    for (std::uint8_t k = 1; k < code; ++k) {
-      if (i >= in.size() || in[i] == 0 || o >= out.size()) return -1;
-      out[o++] = in[i++];
+    // The block's code - 1 data bytes: checked for room once, then copied (none may be zero).
+    const std::size_t k = static_cast<std::size_t>(code) - 1;
+    if (k > in.size() - i || k > out.size() - o) return -1;
+    const std::uint8_t* src = in.data() + i;
+    std::uint8_t* dst = out.data() + o;
+    for (std::size_t j = 0; j < k; ++j) {
+      if (src[j] == 0) return -1;
+      dst[j] = src[j];
     }
+    i += k;
+    o += k;
     if (code != 0xFF && i < in.size()) {
       if (o >= out.size()) return -1;
       out[o++] = 0;

@@ -35,20 +35,31 @@ void SerialDeframer::reset() noexcept {
 
 bool SerialDeframer::push(std::uint8_t byte, SerialFrame& out) noexcept {
   if (byte != 0) {
-    if (discarding_) {
-      ++stats_.bytes_discarded;
-      return false;
-    }
-    if (n_ == sizeof(buf_)) {
-      ++stats_.overlong;
-      stats_.bytes_discarded += n_ + 1;
-      n_ = 0;
-      discarding_ = true;
-      return false;
-    }
-    buf_[n_++] = byte;
+    take_run(&byte, 1);
     return false;
   }
+  return end_run(out);
+}
+
+void SerialDeframer::take_run(const std::uint8_t* p, std::size_t k) noexcept {
+  if (discarding_) {
+    stats_.bytes_discarded += k;
+    return;
+  }
+  const std::size_t room = sizeof(buf_) - n_;
+  if (k <= room) {
+    std::memcpy(buf_ + n_, p, k);
+    n_ += k;
+    return;
+  }
+  // One byte past a full buffer: the run is over-long; it and the rest of it are discarded.
+  ++stats_.overlong;
+  stats_.bytes_discarded += sizeof(buf_) + 1 + (k - room - 1);
+  n_ = 0;
+  discarding_ = true;
+}
+
+bool SerialDeframer::end_run(SerialFrame& out) noexcept {
   // Delimiter: a frame ends here (or an empty run, or the end of a discarded run).
   const std::size_t n = n_;
   n_ = 0;
@@ -89,11 +100,22 @@ bool SerialDeframer::push(std::uint8_t byte, SerialFrame& out) noexcept {
 }
 
 std::size_t SerialDeframer::feed(std::span<const std::uint8_t> bytes, SerialFrame& out, bool* got) noexcept {
+  // Run by run (memchr finds the delimiters), not byte by byte: the same result as push()
+  // on every byte, at a fraction of the work per byte.
   *got = false;
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    if (push(bytes[i], out)) {
+  const std::uint8_t* const begin = bytes.data();
+  const std::uint8_t* const end = begin + bytes.size();
+  for (const std::uint8_t* p = begin; p < end;) {
+    const auto* zero = static_cast<const std::uint8_t*>(std::memchr(p, 0, static_cast<std::size_t>(end - p)));
+    if (!zero) {
+      take_run(p, static_cast<std::size_t>(end - p));
+      break;
+    }
+    if (zero > p) take_run(p, static_cast<std::size_t>(zero - p));
+    p = zero + 1;
+    if (end_run(out)) {
       *got = true;
-      return i + 1;
+      return static_cast<std::size_t>(p - begin);
     }
   }
   return bytes.size();

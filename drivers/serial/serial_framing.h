@@ -46,12 +46,15 @@ class SerialDeframer {
   // Feeds one byte; returns true when it completed a valid frame, now in `out`.
   [[nodiscard]] bool push(std::uint8_t byte, SerialFrame& out) noexcept;
   // Feeds bytes until one frame completes; returns the number of bytes consumed (call again
-  // with the rest). *got tells whether `out` holds a new frame.
+  // with the rest). *got tells whether `out` holds a new frame. Same result as push() on each
+  // byte, scanning for delimiters with memchr and copying whole runs.
   std::size_t feed(std::span<const std::uint8_t> bytes, SerialFrame& out, bool* got) noexcept;
   [[nodiscard]] const SerialDeframerStats& stats() const noexcept { return stats_; }
   void reset() noexcept;
 
  private:
+  void take_run(const std::uint8_t* p, std::size_t k) noexcept;  // k non-zero bytes
+  bool end_run(SerialFrame& out) noexcept;                        // at a delimiter
   std::uint8_t buf_[kSerialMaxWire] = {};
   std::size_t n_ = 0;
   bool discarding_ = false;  // after an over-long run: drop bytes until the next 0x00

@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include <random>
 #include <string>
 #include <vector>
 
@@ -73,4 +74,70 @@ TEST_CASE("the stream splitter finds messages across reads and drops oversized o
   REQUIRE(got.size() == 1);
   CHECK(got[0] == "<echo>");
   CHECK(s.dropped() == 1);
+}
+
+namespace {
+// The splitter's contract byte by byte: a message starts at '<', ends at the next '>', and is
+// dropped if it has more than kMaxMessage characters.
+std::vector<std::string> split_by_byte(const std::string& s, std::uint64_t* dropped) {
+  std::vector<std::string> out;
+  bool in = false;
+  std::string cur;
+  for (char c : s) {
+    if (!in) {
+      if (c == '<') {
+        in = true;
+        cur = "<";
+      }
+      continue;
+    }
+    cur += c;
+    if (c == '>') {
+      in = false;
+      if (cur.size() > kMaxMessage) {
+        ++*dropped;
+      } else {
+        out.push_back(cur);
+      }
+    }
+  }
+  return out;
+}
+}  // namespace
+
+TEST_CASE("the splitter, fed in any chunks, finds the messages its byte-by-byte contract finds") {
+  std::mt19937 rng(3);
+  const char alphabet[] = "<<>> abc01x";
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string s;
+    for (int part = 0; part < 20; ++part) {
+      if (rng() % 6 == 0) {
+        s += "<" + std::string(kMaxMessage - 3 + rng() % 5, 'y') + ">";  // at the size limit
+      } else {
+        for (unsigned k = rng() % 20; k > 0; --k) s += alphabet[rng() % (sizeof(alphabet) - 1)];
+      }
+    }
+    std::uint64_t dropped = 0;
+    const auto want = split_by_byte(s, &dropped);
+    StreamSplitter sp;
+    std::vector<std::string> got;
+    for (std::size_t off = 0; off < s.size();) {
+      const std::size_t chunk = std::min<std::size_t>(s.size() - off, 1 + rng() % 64);
+      for (std::size_t done = 0; done < chunk;) {
+        const char* msg;
+        std::size_t len;
+        done += sp.feed(s.data() + off + done, chunk - done, &msg, &len);
+        if (msg) got.emplace_back(msg, len);
+      }
+      off += chunk;
+    }
+    REQUIRE(got == want);
+    CHECK(sp.dropped() == dropped);
+  }
+}
+
+TEST_CASE("a text longer than any message does not parse") {
+  Message m;
+  CHECK(parse_message("< echo" + std::string(kMaxMessage - 8, ' ') + ">", m));  // kMaxMessage - 1 characters
+  CHECK_FALSE(parse_message("< echo" + std::string(kMaxMessage, ' ') + ">", m));
 }

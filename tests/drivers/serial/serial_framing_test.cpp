@@ -153,3 +153,101 @@ TEST_CASE("deframing does not allocate") {
   CHECK(crease::rt::rt_allocation_count() == before);
   CHECK(d.stats().frames == 10);
 }
+
+TEST_CASE("feed (run by run) gives what push gives on every byte: frames, consumed counts and stats") {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    // A stream of valid frames, garbage, bare delimiters, corrupted frames and over-long runs.
+    Bytes s;
+    for (int part = 0; part < 12; ++part) {
+      switch (rng() % 5) {
+        case 0: {
+          Bytes payload(rng() % 40);
+          for (auto& b : payload) b = static_cast<std::uint8_t>(rng());
+          const Bytes w = wire(static_cast<std::uint8_t>(part), 1, payload);
+          s.insert(s.end(), w.begin(), w.end());
+          break;
+        }
+        case 1:
+          for (unsigned k = rng() % 30; k > 0; --k) s.push_back(static_cast<std::uint8_t>(rng()));
+          break;
+        case 2: s.insert(s.end(), rng() % 3 + 1, 0); break;
+        case 3: {
+          Bytes w = wire(1, 2, {4, 5, 6, 7});
+          w[2 + rng() % (w.size() - 4)] ^= static_cast<std::uint8_t>(1 + rng() % 255);
+          s.insert(s.end(), w.begin(), w.end());
+          break;
+        }
+        default: s.insert(s.end(), kSerialMaxWire - 2 + rng() % 5, 0x5A); break;  // at the edge of over-long
+      }
+    }
+    SerialDeframer a, b;
+    SerialFrame fa, fb;
+    std::vector<std::pair<std::size_t, Bytes>> by_byte, by_feed;  // (stream offset after, payload)
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (a.push(s[i], fa)) by_byte.emplace_back(i + 1, Bytes(fa.payload, fa.payload + fa.len));
+    }
+    for (std::size_t off = 0; off < s.size();) {
+      const std::size_t chunk = std::min<std::size_t>(s.size() - off, 1 + rng() % 700);
+      std::size_t done = 0;
+      while (done < chunk) {
+        bool got = false;
+        done += b.feed({s.data() + off + done, chunk - done}, fb, &got);
+        if (got) by_feed.emplace_back(off + done, Bytes(fb.payload, fb.payload + fb.len));
+      }
+      off += chunk;
+    }
+    REQUIRE(by_feed == by_byte);
+    const auto &x = a.stats(), &y = b.stats();
+    CHECK(x.frames == y.frames);
+    CHECK(x.crc_errors == y.crc_errors);
+    CHECK(x.cobs_errors == y.cobs_errors);
+    CHECK(x.overlong == y.overlong);
+    CHECK(x.seq_gaps == y.seq_gaps);
+    CHECK(x.bytes_discarded == y.bytes_discarded);
+  }
+}
+
+namespace {
+// COBS decoding byte by byte (the reference the block-wise cobs_decode must equal).
+long cobs_decode_by_byte(const Bytes& in, std::size_t cap, Bytes& out) {
+  out.clear();
+  std::size_t i = 0;
+  while (i < in.size()) {
+    const std::uint8_t code = in[i++];
+    if (code == 0) return -1;
+    for (std::uint8_t k = 1; k < code; ++k) {
+      if (i >= in.size() || in[i] == 0 || out.size() >= cap) return -1;
+      out.push_back(in[i++]);
+    }
+    if (code != 0xFF && i < in.size()) {
+      if (out.size() >= cap) return -1;
+      out.push_back(0);
+    }
+  }
+  return static_cast<long>(out.size());
+}
+}  // namespace
+
+TEST_CASE("cobs_decode equals the byte-by-byte definition on valid, corrupted and random input") {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 3000; ++trial) {
+    Bytes raw(rng() % 700);
+    for (auto& b : raw) b = rng() % 4 == 0 ? 0 : static_cast<std::uint8_t>(rng());
+    Bytes in(cobs_max_encoded(raw.size()));
+    in.resize(cobs_encode(raw, in));
+    switch (trial % 3) {
+      case 0: break;                                                        // valid
+      case 1: if (!in.empty()) in[rng() % in.size()] = static_cast<std::uint8_t>(rng()); break;  // one byte changed
+      default: in = raw; break;                                             // not COBS at all
+    }
+    const std::size_t cap = rng() % 2 ? 1024 : rng() % 700;
+    Bytes want;
+    const long n_want = cobs_decode_by_byte(in, cap, want);
+    Bytes got(cap + 1);
+    const long n_got = cobs_decode(in, {got.data(), cap});
+    REQUIRE(n_got == n_want);
+    if (n_got > 0) CHECK(std::equal(want.begin(), want.end(), got.begin()));
+    if (trial % 3 == 0 && cap >= raw.size()) CHECK(n_got == static_cast<long>(raw.size()));
+  }
+}
