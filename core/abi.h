@@ -6,7 +6,9 @@
  * No exception crosses this boundary: the C++ adapters in plugin.h catch them and return a
  * status. Strings in the descriptor live in the library; the host copies them.
  *
- * Return codes (int32_t): 0 ok, 1 degraded, 2 fault, 3 threw (an exception was caught).
+ * Return codes (int32_t): 0 ok, 1 degraded, 2 fault, 3 threw (an exception was caught),
+ * 4 device fault (a driver's device is gone; the plugin stays scheduled: core/status.h). A host
+ * that predates code 4 takes it as an unknown code, i.e. a fault.
  */
 #ifndef CREASE_CORE_ABI_H
 #define CREASE_CORE_ABI_H

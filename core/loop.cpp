@@ -1,9 +1,12 @@
 #include "core/loop.h"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <thread>
 
 #include "core/assert.h"
+#include "rt/alloc_guard.h"
 #include "rt/clock.h"
 
 namespace crease {
@@ -97,9 +100,10 @@ void Loop::adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept {
 }
 
 std::int64_t Loop::run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle,
-                               std::int64_t& t0) noexcept {
+                               const std::uint64_t* allocs, std::int64_t& t0, Status& status) noexcept {
+  const std::uint64_t a0 = allocs != nullptr ? *allocs : 0;
   t0 = rt::now_ns();
-  Status status = Status::ok;
+  status = Status::ok;
   const FaultKind fault = write_phase ? inst.write_rt(cycle, status) : inst.update_rt(cycle, status);
   const std::int64_t t1 = rt::now_ns();
   PluginStats& stats = inst.stats();
@@ -110,19 +114,49 @@ std::int64_t Loop::run_hook_rt(PluginInstance& inst, bool write_phase, const cre
                              t1, inst));
     log_.try_log(rt::LogLevel::error, inst.name().c_str(), "plugin stopped by the firewall: its outputs are safe", t1);
   }
+  // The hook ran on this thread: what the thread's counter gained since a0 is the hook's.
+  const std::uint64_t made = allocs != nullptr ? *allocs - a0 : 0;
+  if (made != 0) {
+    stats.rt_allocations.fetch_add(made, std::memory_order_relaxed);
+    if (inst.limits().deactivate_on_allocation && inst.state.load(std::memory_order_relaxed) == RunState::active) {
+      trip_rt(inst, FaultKind::rt_allocation, static_cast<std::int32_t>(std::min<std::uint64_t>(made, INT32_MAX)),
+              cycle.index, t1);
+    }
+  }
   return t1 - t0;
 }
 
-void Loop::record_execution_rt(PluginInstance& inst, std::int64_t ns, std::uint64_t cycle, std::int64_t t0) noexcept {
+void Loop::trip_rt(PluginInstance& inst, FaultKind kind, std::int32_t code, std::uint64_t cycle, std::int64_t t) noexcept {
+  inst.trip_rt(kind, code, t);
+  inst.stats().faults.fetch_add(1, std::memory_order_relaxed);
+  push_event_rt(make_event(LoopEvent::Type::fault, kind, code, cycle, t, inst));
+  log_.try_log(rt::LogLevel::error, inst.name().c_str(), "plugin stopped by the firewall: its outputs are safe", t);
+}
+
+void Loop::finish_instance_rt(PluginInstance& inst, std::int64_t ns, Status status, std::uint64_t cycle,
+                              std::int64_t t0) noexcept {
   PluginStats& stats = inst.stats();
   stats.execution.record(static_cast<std::uint64_t>(ns), cycle, t0);
   stats.updates.store(stats.updates.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  if (inst.state.load(std::memory_order_relaxed) != RunState::active) return;  // stopped by a hook: a fault
+  const auto before = static_cast<Status>(stats.last_status.load(std::memory_order_relaxed));
+  stats.last_status.store(static_cast<std::uint8_t>(status), std::memory_order_relaxed);
+  if (status == Status::device_fault && before != Status::device_fault) {
+    stats.device_faults.fetch_add(1, std::memory_order_relaxed);
+    push_event_rt(make_event(LoopEvent::Type::device_fault, FaultKind::none, 0, cycle, t0, inst));
+  } else if (status != Status::device_fault && before == Status::device_fault) {
+    push_event_rt(make_event(LoopEvent::Type::device_recovered, FaultKind::none, 0, cycle, t0, inst));
+  }
+  if (inst.over_budget_rt(ns)) {
+    trip_rt(inst, FaultKind::over_budget, static_cast<std::int32_t>(inst.limits().budget_cycles), cycle, t0 + ns);
+  }
 }
 
 void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
   if (Schedule* next = pending_.exchange(nullptr, std::memory_order_acq_rel)) adopt_rt(next, clock);
   const Schedule* s = current_.load(std::memory_order_relaxed);  // only this thread stores it while running
   const crease_cycle cycle{clock.cycle, clock.deadline_ns, clock.period_ns, clock.wake_ns};
+  const std::uint64_t* allocs = count_allocations_.load(std::memory_order_relaxed) ? rt::this_thread_rt_allocations() : nullptr;
   bool any_write = false;
   // Phase 1: update, in run order.
   for (const Schedule::Entry& e : s->entries) {
@@ -132,13 +166,16 @@ void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
     if (st == RunState::active) {
       inst.apply_param_changes_rt();
       std::int64_t t0 = 0;
-      const std::int64_t ns = run_hook_rt(inst, false, cycle, t0);
-      // An instance with a write phase is timed over both hooks (recorded after its write).
+      Status status = Status::ok;
+      const std::int64_t ns = run_hook_rt(inst, false, cycle, allocs, t0, status);
+      // An instance with a write phase is timed over both hooks (accounted after its write).
       if (inst.has_write() && inst.state.load(std::memory_order_relaxed) == RunState::active) {
         e.update_ns = ns;
+        e.update_t0 = t0;
+        e.update_status = status;
         any_write = true;
       } else {
-        record_execution_rt(inst, ns, clock.cycle, t0);
+        finish_instance_rt(inst, ns, status, clock.cycle, t0);
       }
     } else if (st == RunState::deactivate_requested) {
       inst.drive_safe_outputs_rt(cycle.time_ns);
@@ -152,8 +189,9 @@ void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
     if (e.update_ns < 0) continue;
     PluginInstance& inst = *e.instance;
     std::int64_t t0 = 0;
-    const std::int64_t ns = run_hook_rt(inst, true, cycle, t0);
-    record_execution_rt(inst, e.update_ns + ns, clock.cycle, t0);
+    Status status = Status::ok;
+    const std::int64_t ns = run_hook_rt(inst, true, cycle, allocs, t0, status);
+    finish_instance_rt(inst, e.update_ns + ns, worst(e.update_status, status), clock.cycle, e.update_t0);
   }
 }
 

@@ -15,7 +15,14 @@
 //
 // The firewall: an update or write that returns fault, throws, returns an unknown code or
 // writes a non-finite output stops that instance (outputs driven safe, state faulted) and is
-// reported as an event; the loop keeps its timing and runs the others.
+// reported as an event; the loop keeps its timing and runs the others. So is an instance whose
+// update + write ran longer than its time budget (FirewallLimits) for budget_cycles cycles in
+// a row, measured with the two clock reads per hook the loop makes anyway, and, when its
+// limits say so, one that allocated on the heap in a hook. Allocations are counted per
+// instance (PluginStats::rt_allocations) from the loop thread's own counter
+// (rt::this_thread_rt_allocations: one load before and one after each hook) while
+// count_allocations is on (the default). A hook returning Status::device_fault is not a
+// firewall fault: the instance stays scheduled, and each change into and out of it is an event.
 #pragma once
 
 #include <atomic>
@@ -45,6 +52,8 @@ struct Schedule {
     PluginInstance* instance = nullptr;
     PluginInstance* takes_state_from = nullptr;  // set for the new version in a hot-swap
     mutable std::int64_t update_ns = 0;          // loop thread only: this cycle's update time
+    mutable std::int64_t update_t0 = 0;          // loop thread only: when this cycle's update started
+    mutable Status update_status = Status::ok;   // loop thread only: what this cycle's update returned
   };
   std::vector<Entry> entries;  // in run order
   std::uint64_t generation = 0;
@@ -52,7 +61,9 @@ struct Schedule {
 
 // Reported by the loop thread, consumed by the host (non-RT).
 struct LoopEvent {
-  enum class Type : std::uint8_t { fault, swapped, deactivated, state_not_carried };
+  // fault: the firewall stopped it (fault says why; code: the plugin's return code, the budget's
+  // cycles for over_budget, the allocations of the hook for rt_allocation).
+  enum class Type : std::uint8_t { fault, swapped, deactivated, state_not_carried, device_fault, device_recovered };
   Type type = Type::fault;
   FaultKind fault = FaultKind::none;
   std::int32_t code = 0;
@@ -102,6 +113,11 @@ class Loop {
   [[nodiscard]] rt::RtLogQueue& log_queue() noexcept { return log_; }
   [[nodiscard]] std::int64_t period_ns() const noexcept { return thread_.settings().period_ns; }
 
+  // Whether hooks' heap allocations are counted per instance (default on). Any thread; the loop
+  // reads it once per cycle.
+  void set_count_allocations(bool on) noexcept { count_allocations_.store(on, std::memory_order_relaxed); }
+  [[nodiscard]] bool count_allocations() const noexcept { return count_allocations_.load(std::memory_order_relaxed); }
+
   // Runs one cycle on the calling thread (tests and benchmarks of the cycle itself).
   void run_cycle_rt(const rt::CycleClock& clock) noexcept;
 
@@ -110,9 +126,16 @@ class Loop {
   void adopt_rt(Schedule* next, const rt::CycleClock& clock) noexcept;
   void push_event_rt(const LoopEvent& e) noexcept { (void)events_.try_push(&e); }
   // Runs one phase's hook of an active instance and accounts for it: degraded and fault counts,
-  // the firewall event. Returns the hook's duration (ns); t0: when it started.
-  std::int64_t run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle, std::int64_t& t0) noexcept;
-  static void record_execution_rt(PluginInstance& inst, std::int64_t ns, std::uint64_t cycle, std::int64_t t0) noexcept;
+  // allocations (allocs: this thread's counter, or nullptr when not counting), the firewall
+  // event. Returns the hook's duration (ns); t0: when it started; status: what it returned.
+  std::int64_t run_hook_rt(PluginInstance& inst, bool write_phase, const crease_cycle& cycle, const std::uint64_t* allocs,
+                           std::int64_t& t0, Status& status) noexcept;
+  // After an instance's last hook of the cycle: its execution time (update + write), the time
+  // budget, the device-fault transitions.
+  void finish_instance_rt(PluginInstance& inst, std::int64_t ns, Status status, std::uint64_t cycle,
+                          std::int64_t t0) noexcept;
+  // A firewall stop found by the loop itself (over budget, allocation): counted, event, log.
+  void trip_rt(PluginInstance& inst, FaultKind kind, std::int32_t code, std::uint64_t cycle, std::int64_t t) noexcept;
 
   LoopSpec spec_;
   std::atomic<Schedule*> current_{nullptr};   // in schedules_; replaced only by adopt
@@ -121,6 +144,7 @@ class Loop {
   std::vector<std::unique_ptr<Schedule>> schedules_;  // non-RT: every schedule not yet freed
   std::uint64_t published_ = 0;               // non-RT: generation of the last publication
   std::unique_ptr<unsigned char[]> state_buf_;
+  std::atomic<bool> count_allocations_{true};
   rt::QueueChannel events_;
   rt::RtLogQueue log_;
   rt::PeriodicLoop thread_;  // last: its thread stops before the members above go

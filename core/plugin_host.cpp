@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <thread>
+#include <utility>
 
 #include "core/errors.h"
 #include "rt/clock.h"
@@ -21,8 +22,21 @@ const char* to_string(HostEvent::Type t) noexcept {
     case HostEvent::Type::fault: return "fault";
     case HostEvent::Type::activated: return "activated";
     case HostEvent::Type::deactivated: return "deactivated";
+    case HostEvent::Type::device_fault: return "device fault";
+    case HostEvent::Type::device_recovered: return "device recovered";
   }
   return "unknown";
+}
+
+const char* health_of(const InstanceInfo& i) noexcept {
+  if (i.state == RunState::faulted) return "fault";
+  switch (static_cast<Status>(i.stats->last_status.load(std::memory_order_relaxed))) {
+    case Status::device_fault:
+    case Status::fault: return "fault";
+    case Status::degraded: return "degraded";
+    case Status::ok: return "ok";
+  }
+  return "ok";
 }
 
 PluginHost::PluginHost(std::vector<std::filesystem::path> plugin_dirs) : dirs_(std::move(plugin_dirs)) {}
@@ -42,6 +56,7 @@ void PluginHost::set_event_sink(EventSink sink) {
 void PluginHost::record(HostEvent e) {
   if (e.time_ns == 0) e.time_ns = rt::now_ns();
   if (e.type == HostEvent::Type::fault) ++faults_;
+  if (e.type == HostEvent::Type::device_fault) ++device_faults_;
   if (sink_) sink_(e);
   events_.push_back(std::move(e));
 }
@@ -127,6 +142,14 @@ std::size_t PluginHost::retired_count() const {
   return retired_.size();
 }
 
+FirewallLimits PluginHost::limits_of(const InstanceSpec& spec, const Loop& loop) {
+  FirewallLimits l;
+  l.budget_ns = spec.budget_ns ? *spec.budget_ns : loop.period_ns();
+  l.budget_cycles = spec.budget_cycles;
+  l.deactivate_on_allocation = spec.deactivate_on_allocation;
+  return l;
+}
+
 void PluginHost::add_instance(const InstanceSpec& spec) {
   std::lock_guard lock(mu_);
   if (find(spec.name) != nullptr) throw ConfigError("instance '" + spec.name + "' is defined twice");
@@ -137,7 +160,7 @@ void PluginHost::add_instance(const InstanceSpec& spec) {
   std::unique_ptr<PluginInstance> inst;
   try {
     inst = std::make_unique<PluginInstance>(spec.name, lib, spec.params, spec.ports, ports_, &loop->log_queue(),
-                                            std::make_shared<PluginStats>());
+                                            std::make_shared<PluginStats>(), limits_of(spec, *loop));
     if (spec.enabled) inst->activate();
   } catch (...) {
     inst.reset();
@@ -192,11 +215,14 @@ void PluginHost::swap(const std::string& name, const std::string& library, const
   std::shared_ptr<PluginLibrary> lib = PluginLibrary::open(library, dirs_);
   const Params& p = params ? *params : m->spec.params;
   auto next = std::make_unique<PluginInstance>(name, lib, p, m->spec.ports, ports_, &m->loop->log_queue(),
-                                               m->instance->stats_ptr());
+                                               m->instance->stats_ptr(), limits_of(m->spec, *m->loop));
   const RunState was = m->instance->state.load(std::memory_order_acquire);
   if (was == RunState::active || was == RunState::faulted) next->activate();  // throws: old untouched
 
   std::unique_ptr<PluginInstance> old = std::move(m->instance);
+  // Named now, from the libraries themselves: the swap event is recorded when the loop adopts.
+  m->swap_detail = lib->path().filename().string() + " (" + lib->plugin_name() + " " + lib->plugin_version() +
+                   ") from " + lib->path().string() + ", replacing " + old->library().path().filename().string();
   m->instance = std::move(next);
   m->spec.library = library;
   if (params) m->spec.params = *params;
@@ -279,22 +305,38 @@ void PluginHost::drain_locked() {
       const std::string name = e.instance;
       switch (e.type) {
         case LoopEvent::Type::fault: {
-          record({HostEvent::Type::fault, name, l->spec().name, to_string(e.fault), e.cycle, e.time_ns});
+          Managed* m = find(name);
+          std::string detail = to_string(e.fault);
+          if (e.fault == FaultKind::over_budget && m) {
+            detail += " (" + format_number(double(m->instance->limits().budget_ns) / 1000.0) + " us) for " +
+                      std::to_string(e.code) + " consecutive cycles";
+          } else if (e.fault == FaultKind::rt_allocation) {
+            detail += " (" + std::to_string(e.code) + " allocations in one hook)";
+          }
+          record({HostEvent::Type::fault, name, l->spec().name, detail, e.cycle, e.time_ns});
           spdlog::error("instance '{}' in loop '{}' {} at cycle {}: deactivated, outputs driven safe", name,
-                        l->spec().name, to_string(e.fault), e.cycle);
-          if (Managed* m = find(name); m && m->instance->state.load(std::memory_order_acquire) == RunState::faulted) {
+                        l->spec().name, detail, e.cycle);
+          if (m && m->instance->state.load(std::memory_order_acquire) == RunState::faulted) {
             m->instance->call_deactivate();
           }
           break;
         }
         case LoopEvent::Type::swapped:
         case LoopEvent::Type::state_not_carried: {
-          const Managed* m = find(name);
-          std::string detail = m ? m->instance->library().plugin_name() + " " + m->instance->library().plugin_version() : "";
+          Managed* m = find(name);
+          std::string detail;
+          if (m) detail = std::exchange(m->swap_detail, std::string());
           record({e.type == LoopEvent::Type::swapped ? HostEvent::Type::swapped : HostEvent::Type::swap_state_lost, name,
                   l->spec().name, detail, e.cycle, e.time_ns});
           break;
         }
+        case LoopEvent::Type::device_fault:
+          record({HostEvent::Type::device_fault, name, l->spec().name, "its device is gone: safe state commanded", e.cycle,
+                  e.time_ns});
+          break;
+        case LoopEvent::Type::device_recovered:
+          record({HostEvent::Type::device_recovered, name, l->spec().name, {}, e.cycle, e.time_ns});
+          break;
         case LoopEvent::Type::deactivated: break;  // recorded by deactivate()
       }
     }
@@ -325,7 +367,7 @@ std::vector<InstanceInfo> PluginHost::instances() const {
     const PluginInstance& i = *m.instance;
     out.push_back({m.spec.name, m.spec.loop, i.library().path().string(), i.library().plugin_name(),
                    i.library().plugin_version(), m.spec.order, i.state.load(std::memory_order_acquire),
-                   i.last_fault.load(std::memory_order_relaxed), i.stats_ptr(), i.tunables()});
+                   i.last_fault.load(std::memory_order_relaxed), i.stats_ptr(), i.tunables(), i.limits()});
   }
   return out;
 }
@@ -345,6 +387,22 @@ std::vector<HostEvent> PluginHost::events() const {
 std::uint64_t PluginHost::fault_count() const {
   std::lock_guard lock(mu_);
   return faults_;
+}
+
+std::uint64_t PluginHost::device_fault_count() const {
+  std::lock_guard lock(mu_);
+  return device_faults_;
+}
+
+std::size_t PluginHost::devices_in_fault() const {
+  std::lock_guard lock(mu_);
+  std::size_t n = 0;
+  for (const Managed& m : managed_) {
+    const PluginInstance& i = *m.instance;
+    n += i.state.load(std::memory_order_acquire) == RunState::active &&
+         static_cast<Status>(i.stats_ptr()->last_status.load(std::memory_order_relaxed)) == Status::device_fault;
+  }
+  return n;
 }
 
 }  // namespace crease

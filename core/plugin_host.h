@@ -33,11 +33,17 @@ struct InstanceSpec {
   Params params;
   std::map<std::string, std::string> ports;  // plugin port name -> global port name
   bool enabled = true;  // activated when added
+  // The firewall's time budget for update + write per cycle: absent, the loop's period (an
+  // instance alone taking a whole period makes the loop miss deadlines); 0, none. Over it for
+  // budget_cycles consecutive cycles, the instance is stopped as a faulting one.
+  std::optional<std::int64_t> budget_ns;
+  std::uint32_t budget_cycles = FirewallLimits::kDefaultBudgetCycles;
+  bool deactivate_on_allocation = false;  // a heap allocation in update/write stops it
 };
 
 // Something that happened to an instance, for logs and the report's timeline.
 struct HostEvent {
-  enum class Type { loaded, unloaded, swapped, swap_state_lost, fault, activated, deactivated };
+  enum class Type { loaded, unloaded, swapped, swap_state_lost, fault, activated, deactivated, device_fault, device_recovered };
   Type type = Type::loaded;
   std::string instance;
   std::string loop;
@@ -54,7 +60,11 @@ struct InstanceInfo {
   FaultKind last_fault = FaultKind::none;
   std::shared_ptr<PluginStats> stats;
   std::vector<Tunable> tunables;
+  FirewallLimits limits;
 };
+// "fault" when the firewall stopped it or its device is gone (its last status device_fault),
+// "degraded" when its last status was, else "ok".
+[[nodiscard]] const char* health_of(const InstanceInfo& i) noexcept;
 
 class PluginHost {
  public:
@@ -97,6 +107,10 @@ class PluginHost {
   [[nodiscard]] std::vector<const Loop*> loops() const;
   [[nodiscard]] std::vector<HostEvent> events() const;  // the whole timeline so far
   [[nodiscard]] std::uint64_t fault_count() const;
+  // Device faults reported (Status::device_fault after another status), and how many instances
+  // report one now.
+  [[nodiscard]] std::uint64_t device_fault_count() const;
+  [[nodiscard]] std::size_t devices_in_fault() const;
   [[nodiscard]] const std::vector<std::filesystem::path>& plugin_dirs() const noexcept { return dirs_; }
 
   // How long a schedule change waits for a loop to adopt it (default kAdoptTimeout). A change
@@ -112,7 +126,10 @@ class PluginHost {
     InstanceSpec spec;
     std::unique_ptr<PluginInstance> instance;
     Loop* loop = nullptr;
+    std::string swap_detail;  // what the pending swap event says: the library swapped in, and out
   };
+  // The firewall limits of `spec` in `loop`.
+  static FirewallLimits limits_of(const InstanceSpec& spec, const Loop& loop);
   Managed* find(const std::string& name);
   const Managed* find(const std::string& name) const;
   Loop* find_loop(const std::string& name) const;
@@ -144,6 +161,7 @@ class PluginHost {
   std::chrono::milliseconds adopt_timeout_ = kAdoptTimeout;
   std::vector<HostEvent> events_;
   std::uint64_t faults_ = 0;
+  std::uint64_t device_faults_ = 0;
   EventSink sink_;
   bool running_ = false;
 };

@@ -24,19 +24,23 @@ const char* to_string(FaultKind k) noexcept {
     case FaultKind::threw: return "threw an exception";
     case FaultKind::non_finite_output: return "wrote a non-finite output";
     case FaultKind::bad_status: return "returned an unknown status";
+    case FaultKind::over_budget: return "ran over its time budget";
+    case FaultKind::rt_allocation: return "allocated on the heap in a real-time hook";
   }
   return "unknown";
 }
 
 PluginInstance::PluginInstance(std::string name, std::shared_ptr<PluginLibrary> library, const Params& params,
                                std::map<std::string, std::string> port_remap, PortRegistry& registry,
-                               rt::RtLogQueue* log, std::shared_ptr<PluginStats> stats)
+                               rt::RtLogQueue* log, std::shared_ptr<PluginStats> stats, FirewallLimits limits)
     : library_(std::move(library)),
       d_(library_->descriptor()),
       name_(std::move(name)),
       stats_(std::move(stats)),
       binder_(registry, name_, std::move(port_remap), &flags_, log),
-      param_changes_(sizeof(ParamChange), 64) {
+      param_changes_(sizeof(ParamChange), 64),
+      limits_(limits) {
+  if (limits_.budget_cycles == 0) limits_.budget_cycles = 1;
   const std::string who = "instance '" + name_ + "' (" + library_->path().filename().string() + ")";
   self_ = d_.create();
   if (self_ == nullptr) throw LoadError(who + ": the plugin could not create an instance");
@@ -71,6 +75,7 @@ void PluginInstance::activate() {
     throw Error("instance '" + name_ + "': activate failed: " + err);
   }
   hook_active_ = true;
+  over_budget_run_ = 0;  // the loop does not run it now: no race
   last_fault.store(FaultKind::none, std::memory_order_relaxed);
   state.store(RunState::active, std::memory_order_release);
 }
@@ -139,17 +144,29 @@ FaultKind PluginInstance::classify_rt(std::int32_t code, const crease_cycle& cyc
     kind = FaultKind::fault_status;
   } else if (code == 3) {
     kind = FaultKind::threw;
-  } else if (code != 0 && code != 1) {
+  } else if (code != 0 && code != 1 && code != 4) {  // ok, degraded, device_fault
     kind = FaultKind::bad_status;
   }
   status = kind == FaultKind::none ? static_cast<Status>(code) : Status::fault;
-  if (kind != FaultKind::none) {
-    drive_safe_outputs(cycle.time_ns);
-    last_code.store(code, std::memory_order_relaxed);
-    last_fault.store(kind, std::memory_order_relaxed);
-    state.store(RunState::faulted, std::memory_order_release);
-  }
+  if (kind != FaultKind::none) trip_rt(kind, code, cycle.time_ns);
   return kind;
+}
+
+bool PluginInstance::over_budget_rt(std::int64_t cycle_ns) noexcept {
+  if (limits_.budget_ns <= 0) return false;
+  if (cycle_ns <= limits_.budget_ns) {
+    over_budget_run_ = 0;
+    return false;
+  }
+  stats_->over_budget.fetch_add(1, std::memory_order_relaxed);
+  return ++over_budget_run_ >= limits_.budget_cycles;
+}
+
+void PluginInstance::trip_rt(FaultKind kind, std::int32_t code, std::int64_t stamp_ns) noexcept {
+  drive_safe_outputs(stamp_ns);
+  last_code.store(code, std::memory_order_relaxed);
+  last_fault.store(kind, std::memory_order_relaxed);
+  state.store(RunState::faulted, std::memory_order_release);
 }
 
 }  // namespace crease

@@ -1,5 +1,5 @@
 // Replacement global operator new/delete that count calls on RT-marked threads.
-// Linked (as crease_rt_alloc_hooks) into tests and crease-bench, never into creased.
+// Linked (as crease_rt_alloc_hooks) into creased, the tests and crease-bench.
 // The executable exports these (ENABLE_EXPORTS), so dlopen'd plugins allocate through them too.
 #include <cstdlib>
 #include <new>

@@ -214,6 +214,22 @@ void read_ports(const std::string& f, const MapReader& m, PluginConfig& p) {
   }
 }
 
+// budget: {time_us, cycles}
+BudgetConfig read_budget(const MapReader& m) {
+  BudgetConfig b;
+  b.loc = m.loc();
+  if (m.has("time_us")) b.time_us = read_number(m.file(), m.get("time_us"), m.path_of("time_us"), 0.0, 1e7, false);
+  if (m.has("cycles")) b.cycles = static_cast<int>(read_int(m.file(), m.get("cycles"), m.path_of("cycles"), 1, 1000000));
+  return b;
+}
+
+AllocationPolicy read_allocation_policy(const std::string& f, const YAML::Node& node, const std::string& path) {
+  const std::string v = read_string(f, node, path);
+  if (v == "count") return AllocationPolicy::count;
+  if (v == "deactivate") return AllocationPolicy::deactivate;
+  throw ConfigError(loc_of(f, node), path, "expected 'count' or 'deactivate', got '" + v + "'");
+}
+
 void read_plugins(const MapReader& root, DaemonConfig& cfg) {
   const std::string& f = root.file();
   if (!root.has("plugins")) return;
@@ -224,7 +240,8 @@ void read_plugins(const MapReader& root, DaemonConfig& cfg) {
   }
   for (std::size_t i = 0; i < plugins.size(); ++i) {
     const MapReader m(f, plugins[i], index_path("plugins", i),
-                      {"name", "library", "loop", "order", "enabled", "params", "ports"});
+                      {"name", "library", "loop", "order", "enabled", "params", "ports", "budget",
+                       "on_rt_allocation"});
     PluginConfig p;
     p.loc = m.loc();
     p.params_loc = p.loc;
@@ -277,13 +294,17 @@ void read_plugins(const MapReader& root, DaemonConfig& cfg) {
       p.params = YAML::Node(YAML::NodeType::Map);
     }
     read_ports(f, m, p);
+    if (m.has("budget")) p.budget = read_budget(MapReader(f, m.get("budget"), m.path_of("budget"), {"time_us", "cycles"}));
+    if (m.has("on_rt_allocation")) {
+      p.on_rt_allocation = read_allocation_policy(f, m.get("on_rt_allocation"), m.path_of("on_rt_allocation"));
+    }
     cfg.plugins.push_back(std::move(p));
   }
 }
 
 void read_safety(const MapReader& root, DaemonConfig& cfg) {
   if (!root.has("safety")) return;
-  const MapReader m(root.file(), root.get("safety"), "safety", {"on_fault", "max_overruns_per_s"});
+  const MapReader m(root.file(), root.get("safety"), "safety", {"on_fault", "max_overruns_per_s", "on_rt_allocation"});
   const std::string& f = m.file();
   cfg.safety.loc = m.loc();
   if (m.has("on_fault")) {
@@ -300,6 +321,9 @@ void read_safety(const MapReader& root, DaemonConfig& cfg) {
   if (m.has("max_overruns_per_s")) {
     cfg.safety.max_overruns_per_s = read_number(f, m.get("max_overruns_per_s"),
                                                 m.path_of("max_overruns_per_s"), 0.0, 1e9, false);
+  }
+  if (m.has("on_rt_allocation")) {
+    cfg.safety.on_rt_allocation = read_allocation_policy(f, m.get("on_rt_allocation"), m.path_of("on_rt_allocation"));
   }
 }
 
@@ -383,6 +407,14 @@ const char* to_string(FaultPolicy p) noexcept {
   switch (p) {
     case FaultPolicy::deactivate: return "deactivate";
     case FaultPolicy::stop: return "stop";
+  }
+  return "?";
+}
+
+const char* to_string(AllocationPolicy p) noexcept {
+  switch (p) {
+    case AllocationPolicy::count: return "count";
+    case AllocationPolicy::deactivate: return "deactivate";
   }
   return "?";
 }

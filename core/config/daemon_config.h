@@ -72,6 +72,18 @@ struct LoopConfig {
   [[nodiscard]] std::int64_t period_ns() const noexcept;
 };
 
+enum class FaultPolicy { deactivate, stop };
+// What a heap allocation in a plugin's update/write does: always counted; `deactivate` also
+// stops the plugin as a fault would.
+enum class AllocationPolicy { count, deactivate };
+
+// The firewall's time budget of one instance: `budget: {time_us: T, cycles: N}`.
+struct BudgetConfig {
+  std::optional<double> time_us;  // [0, 1e7]; 0 = no budget; absent: the loop's period
+  int cycles = 20;                // [1, 1000000]: consecutive cycles over budget before it is stopped
+  SourceLoc loc;
+};
+
 struct PluginConfig {
   std::string name;     // instance name, [a-z][a-z0-9_]*, unique
   std::string library;  // "crease_counter" -> libcrease_counter.so in a plugin dir, or a path
@@ -80,15 +92,17 @@ struct PluginConfig {
   bool enabled = true;
   YAML::Node params;    // a map (possibly empty), marks kept; validated by the plugin
   std::map<std::string, std::string> ports;  // local port name -> global port name
+  BudgetConfig budget;
+  std::optional<AllocationPolicy> on_rt_allocation;  // absent: safety.on_rt_allocation
   SourceLoc loc;        // the list item
   SourceLoc params_loc; // the params map, or the item when absent
 };
 
-enum class FaultPolicy { deactivate, stop };
 
 struct SafetyConfig {
   FaultPolicy on_fault = FaultPolicy::deactivate;
   double max_overruns_per_s = 0;  // 0 = no limit; else stop when exceeded
+  AllocationPolicy on_rt_allocation = AllocationPolicy::count;  // every instance's default
   SourceLoc loc;
 };
 
@@ -133,5 +147,6 @@ void override_param(DaemonConfig& config, const std::string& assignment);
 
 [[nodiscard]] const char* to_string(OverrunPolicy p) noexcept;
 [[nodiscard]] const char* to_string(FaultPolicy p) noexcept;
+[[nodiscard]] const char* to_string(AllocationPolicy p) noexcept;
 
 }  // namespace crease::config

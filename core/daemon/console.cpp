@@ -5,6 +5,8 @@
 namespace crease::daemon {
 namespace {
 double us(std::uint64_t ns) { return double(ns) / 1000.0; }
+// ", what N" when n > 0, else nothing.
+std::string counted(const char* what, std::uint64_t n) { return n > 0 ? what + std::to_string(n) : std::string(); }
 }  // namespace
 
 std::string progress_line(const PluginHost& host, double t_s, const std::vector<FigureReading>& figures) {
@@ -18,6 +20,7 @@ std::string progress_line(const PluginHost& host, double t_s, const std::vector<
     line += buf;
   }
   line += " faults " + std::to_string(host.fault_count());
+  if (const std::size_t n = host.devices_in_fault()) line += ", devices in fault " + std::to_string(n);
   return line + progress_text(figures);
 }
 
@@ -35,12 +38,16 @@ void print_summary(const PluginHost& host, const SummaryFacts& f) {
     for (const InstanceInfo& i : instances) {
       if (i.loop != l->spec().name) continue;
       const auto x = i.stats->execution.snapshot();
-      std::printf("    %-12s %8s %10llu %10s %10s %8.1fus %8.1fus  %s, faults %llu, swaps %llu\n", i.name.c_str(), "",
-                  (unsigned long long)i.stats->updates.load(), "", "", us(x.max_ns), us(x.percentile(99)),
-                  to_string(i.state), (unsigned long long)i.stats->faults.load(), (unsigned long long)i.stats->swaps.load());
+      std::printf("    %-12s %8s %10llu %10s %10s %8.1fus %8.1fus  %s, faults %llu, swaps %llu%s%s%s\n", i.name.c_str(),
+                  "", (unsigned long long)i.stats->updates.load(), "", "", us(x.max_ns), us(x.percentile(99)),
+                  to_string(i.state), (unsigned long long)i.stats->faults.load(), (unsigned long long)i.stats->swaps.load(),
+                  counted(", device faults ", i.stats->device_faults.load()).c_str(),
+                  counted(", over budget ", i.stats->over_budget.load()).c_str(),
+                  counted(", RT allocations ", i.stats->rt_allocations.load()).c_str());
     }
   }
-  std::printf("  faults: %llu\n", (unsigned long long)host.fault_count());
+  std::printf("  faults: %llu, device faults: %llu\n", (unsigned long long)host.fault_count(),
+              (unsigned long long)host.device_fault_count());
   std::printf("%s", summary_text(f.figures).c_str());
   std::fflush(stdout);
 }

@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -34,7 +35,8 @@ void log_step(const rt::SetupStep& step) {
   else spdlog::warn("{}: not applied: {}", step.what, step.why);
 }
 
-InstanceSpec to_spec(const config::PluginConfig& p, const std::string& file, std::size_t index) {
+InstanceSpec to_spec(const config::PluginConfig& p, const config::SafetyConfig& safety, const std::string& file,
+                     std::size_t index) {
   InstanceSpec s;
   s.name = p.name;
   s.library = p.library;
@@ -43,6 +45,9 @@ InstanceSpec to_spec(const config::PluginConfig& p, const std::string& file, std
   s.enabled = p.enabled;
   s.ports = p.ports;
   s.params = Params(p.params, file, "plugins[" + std::to_string(index) + "].params");
+  if (p.budget.time_us) s.budget_ns = static_cast<std::int64_t>(std::llround(*p.budget.time_us * 1000.0));
+  s.budget_cycles = static_cast<std::uint32_t>(p.budget.cycles);
+  s.deactivate_on_allocation = p.on_rt_allocation.value_or(safety.on_rt_allocation) == config::AllocationPolicy::deactivate;
   return s;
 }
 
@@ -80,6 +85,10 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
   host_ = std::make_unique<PluginHost>(dirs);
   host_->set_event_sink([](const HostEvent& e) {
     if (e.type == HostEvent::Type::fault) return;  // the host logs faults itself
+    if (e.type == HostEvent::Type::device_fault) {
+      spdlog::warn("{} '{}' in loop '{}': {}", to_string(e.type), e.instance, e.loop, e.detail);
+      return;
+    }
     spdlog::info("{} '{}' in loop '{}'{}{}", to_string(e.type), e.instance, e.loop, e.detail.empty() ? "" : ": ", e.detail);
   });
   for (const auto& l : config_.loops) host_->add_loop({l.name, l.rate_hz, l.priority, l.cpu, l.phase_ns});
@@ -88,7 +97,7 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
     check_startup_stop("before plugin " + std::to_string(i + 1) + " of " + std::to_string(config_.plugins.size()) +
                        " ('" + p.name + "')");
     try {
-      host_->add_instance(to_spec(p, config_.file, i));
+      host_->add_instance(to_spec(p, config_.safety, config_.file, i));
     } catch (const std::exception& e) {
       // Prefix with where the instance is declared, unless the message already points there.
       const std::string what = e.what();

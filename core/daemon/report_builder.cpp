@@ -32,6 +32,8 @@ const char* event_kind(HostEvent::Type t) {
     case HostEvent::Type::fault: return "fault";
     case HostEvent::Type::activated: return "activate";
     case HostEvent::Type::deactivated: return "deactivate";
+    case HostEvent::Type::device_fault: return "device_fault";
+    case HostEvent::Type::device_recovered: return "device_recovered";
   }
   return "event";
 }
@@ -87,6 +89,11 @@ report::TimingReport build_report(const PluginHost& host, const RunFacts& facts)
         pt.execution = report::from_snapshot(i.stats->execution.snapshot());
         pt.faults = i.stats->faults.load();
         pt.swaps = i.stats->swaps.load();
+        pt.health = health_of(i);
+        pt.budget_us = double(i.limits.budget_ns) / 1000.0;
+        pt.over_budget = i.stats->over_budget.load();
+        pt.rt_allocations = i.stats->rt_allocations.load();
+        pt.device_faults = i.stats->device_faults.load();
         lt.plugins.push_back(std::move(pt));
       }
     }

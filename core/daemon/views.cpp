@@ -1,6 +1,7 @@
 #include "core/daemon/views.h"
 #include "core/daemon/sequences.h"
 #include "core/report/report_json.h"
+#include "rt/alloc_guard.h"
 
 namespace crease::daemon {
 namespace {
@@ -15,6 +16,8 @@ nlohmann::json status_view(const PluginHost& host, const RunFacts& facts, std::i
           {"loops", host.loops().size()},
           {"plugins", host.instances().size()},
           {"faults", host.fault_count()},
+          {"device_faults", host.device_fault_count()},
+          {"devices_in_fault", host.devices_in_fault()},
           {"sched_fifo", facts.sched_fifo_applied},
           {"mlockall", facts.mlockall_applied}};
   if (server != nullptr) {
@@ -72,6 +75,13 @@ nlohmann::json plugins_view(const PluginHost& host) {
                    {"degraded", i.stats->degraded.load()},
                    {"faults", i.stats->faults.load()},
                    {"swaps", i.stats->swaps.load()},
+                   {"health", health_of(i)},
+                   {"device_faults", i.stats->device_faults.load()},
+                   {"budget_us", us(static_cast<std::uint64_t>(i.limits.budget_ns))},
+                   {"budget_cycles", i.limits.budget_cycles},
+                   {"over_budget", i.stats->over_budget.load()},
+                   {"rt_allocations", i.stats->rt_allocations.load()},
+                   {"on_rt_allocation", i.limits.deactivate_on_allocation ? "deactivate" : "count"},
                    {"exec_p99_us", us(x.percentile(99))},
                    {"tunables", tunables}});
   }
@@ -104,8 +114,24 @@ nlohmann::json ports_view(const PortRegistry& ports) {
 }
 
 nlohmann::json stats_view(const PluginHost& host, const control::ControlServer* server) {
+  nlohmann::json plugins = nlohmann::json::array();
+  std::uint64_t allocations = 0;
+  for (const InstanceInfo& i : host.instances()) {
+    allocations += i.stats->rt_allocations.load();
+    plugins.push_back({{"name", i.name},
+                       {"loop", i.loop},
+                       {"state", to_string(i.state)},
+                       {"health", health_of(i)},
+                       {"faults", i.stats->faults.load()},
+                       {"device_faults", i.stats->device_faults.load()},
+                       {"over_budget", i.stats->over_budget.load()},
+                       {"rt_allocations", i.stats->rt_allocations.load()}});
+  }
   return {{"control", server ? server->counters().to_json() : nlohmann::json()},
           {"faults", host.fault_count()},
+          {"device_faults", host.device_fault_count()},
+          {"rt_allocations", {{"counted", rt::alloc_hooks_installed()}, {"total", allocations}}},
+          {"plugins", plugins},
           {"loops", loops_view(host)}};
 }
 

@@ -163,8 +163,11 @@ std::string render_text(const TimingReport& r) {
               (s.time_ns - r.start_ns) * 1e-9, s.value_ns / 1e3);
     }
     for (const PluginTiming& p : l.plugins) {
-      appendf(out, "#   plugin %s (%s, %s): faults=%" PRIu64 " swaps=%" PRIu64 "\n", p.name.c_str(),
-              p.library.c_str(), p.state.c_str(), p.faults, p.swaps);
+      appendf(out,
+              "#   plugin %s (%s, %s): faults=%" PRIu64 " swaps=%" PRIu64 " health=%s budget_us=%.1f over_budget=%" PRIu64
+              " rt_allocations=%" PRIu64 " device_faults=%" PRIu64 "\n",
+              p.name.c_str(), p.library.c_str(), p.state.c_str(), p.faults, p.swaps,
+              p.health.empty() ? "-" : p.health.c_str(), p.budget_us, p.over_budget, p.rt_allocations, p.device_faults);
       append_percentiles(out, ("  execution " + p.name).c_str(), p.execution);
     }
   }

@@ -139,7 +139,7 @@ std::string svg_timeline(const TimingReport& r) {
   double row_y = 28;
   s += "<text x=\"4\" y=\"" + num(row_y + 4) + "\">events</text>";
   for (const Event& e : r.events) {
-    const bool fault = e.kind == "fault";
+    const bool fault = e.kind == "fault" || e.kind == "device_fault";
     const char* color = fault ? "#c00" : (e.kind == "hot_swap" ? "#06c" : "#888");
     s += "<circle cx=\"" + num(x(e.time_ns)) + "\" cy=\"" + num(row_y) + "\" r=\"6\" fill=\"" +
          color + "\"><title>" + esc(e.kind + " " + e.loop + "/" + e.plugin + " " + e.detail) +
@@ -222,13 +222,18 @@ std::string render_html(const TimingReport& r) {
          "</div>\n";
     h += std::string("<h3>Execution time per plugin</h3><table><tr><th class=\"l\">plugin</th>"
                      "<th class=\"l\">library</th><th class=\"l\">state</th><th>faults</th>"
-                     "<th>swaps</th>") + kDistHead + "</tr>";
-    h += "<tr><td class=\"l\"><i>whole cycle</i></td><td></td><td></td><td></td><td></td>" +
+                     "<th>swaps</th><th class=\"l\">health</th><th>budget us</th><th>over budget</th>"
+                     "<th>RT allocations</th><th>device faults</th>") + kDistHead + "</tr>";
+    h += "<tr><td class=\"l\"><i>whole cycle</i></td><td></td><td></td><td></td><td></td>"
+         "<td></td><td></td><td></td><td></td><td></td>" +
          dist_cells(l.execution) + "</tr>";
     for (const PluginTiming& p : l.plugins) {
       h += "<tr><td class=\"l\">" + esc(p.name) + "</td><td class=\"l\">" + esc(p.library) +
            "</td><td class=\"l\">" + esc(p.state) + "</td><td>" + std::to_string(p.faults) +
-           "</td><td>" + std::to_string(p.swaps) + "</td>" + dist_cells(p.execution) + "</tr>";
+           "</td><td>" + std::to_string(p.swaps) + "</td><td class=\"l\">" + esc(p.health) + "</td><td>" +
+           (p.budget_us > 0 ? num(p.budget_us) : std::string("none")) + "</td><td>" + std::to_string(p.over_budget) +
+           "</td><td>" + std::to_string(p.rt_allocations) + "</td><td>" + std::to_string(p.device_faults) + "</td>" +
+           dist_cells(p.execution) + "</tr>";
     }
     h += "</table>\n<div class=\"plots\">";
     for (const PluginTiming& p : l.plugins) {

@@ -37,11 +37,13 @@ void from_json(const nlohmann::json& j, Distribution& v) {
 void to_json(nlohmann::json& j, const PluginTiming& v) {
   j = nlohmann::json::object();
   CREASE_J_OUT(name) CREASE_J_OUT(library) CREASE_J_OUT(state) CREASE_J_OUT(faults)
-  CREASE_J_OUT(swaps) CREASE_J_OUT(execution)
+  CREASE_J_OUT(swaps) CREASE_J_OUT(execution) CREASE_J_OUT(health) CREASE_J_OUT(budget_us)
+  CREASE_J_OUT(over_budget) CREASE_J_OUT(rt_allocations) CREASE_J_OUT(device_faults)
 }
 void from_json(const nlohmann::json& j, PluginTiming& v) {
   CREASE_J_IN(name) CREASE_J_IN(library) CREASE_J_IN(state) CREASE_J_IN(faults)
-  CREASE_J_IN(swaps) CREASE_J_IN(execution)
+  CREASE_J_IN(swaps) CREASE_J_IN(execution) CREASE_J_IN(health) CREASE_J_IN(budget_us)
+  CREASE_J_IN(over_budget) CREASE_J_IN(rt_allocations) CREASE_J_IN(device_faults)
 }
 
 void to_json(nlohmann::json& j, const LoopTiming& v) {

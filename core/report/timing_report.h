@@ -48,6 +48,11 @@ struct PluginTiming {
   Distribution execution;
   std::uint64_t faults = 0;
   std::uint64_t swaps = 0;
+  std::string health;               // "ok", "degraded", "fault" (its device is gone), "" unknown
+  double budget_us = 0;             // the firewall's time budget per cycle; 0 = none
+  std::uint64_t over_budget = 0;    // cycles over that budget
+  std::uint64_t rt_allocations = 0; // heap allocations in its update/write
+  std::uint64_t device_faults = 0;  // times its device went into fault
 };
 
 struct LoopTiming {

@@ -24,9 +24,13 @@ namespace crease::drivers {
   return DeviceHealth::fault;
 }
 
-// A plugin stays scheduled through link faults (it recovers by itself): degraded, never error.
-[[nodiscard]] inline Status to_plugin_status(LinkHealth h) noexcept {
-  return h == LinkHealth::ok ? Status::ok : Status::degraded;
+// A plugin stays scheduled through link faults (it recovers by itself): a `fault` health after
+// start-up (monitor.past_start_up()) is Status::device_fault, which the host counts as a device
+// fault and shows as the instance's health until the link is ok or degraded again; before
+// first contact, and for a degraded link, Status::degraded. Never Status::fault.
+[[nodiscard]] inline Status to_plugin_status(LinkHealth h, const LinkMonitor& monitor) noexcept {
+  if (h == LinkHealth::ok) return Status::ok;
+  return h == LinkHealth::fault && monitor.past_start_up() ? Status::device_fault : Status::degraded;
 }
 
 // Configure time: the node (`node`, 1..126), the link monitor and the bus the parameters name

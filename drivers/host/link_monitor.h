@@ -20,6 +20,9 @@ struct LinkMonitorConfig {
   int timeout_cycles = 2;         // cycles without a fresh status before fault
   int crc_window_cycles = 100;
   int crc_threshold = 10;         // bad-CRC frames within the window before fault
+  // Start-up: cycles the device has to answer a first time before its silence counts as a
+  // device fault (a link that never answered is `fault` but not yet reported as gone).
+  int first_contact_cycles = 1000;
 };
 
 struct LinkCounters {
@@ -47,6 +50,12 @@ class LinkMonitor {
   [[nodiscard]] bool fresh_this_cycle() const noexcept { return fresh_this_cycle_; }
   [[nodiscard]] int silent_cycles() const noexcept { return silent_cycles_; }
   [[nodiscard]] bool emergency_active() const noexcept { return emergency_; }
+  // The device has answered once, or first_contact_cycles passed without an answer: from here
+  // on a `fault` health is the device's fault (silent past the timeout, bus-off, CRC errors, an
+  // emergency), reported to the host as Status::device_fault (device_port_glue.h).
+  [[nodiscard]] bool past_start_up() const noexcept {
+    return ever_fresh_ || cycle_ >= static_cast<std::uint64_t>(cfg_.first_contact_cycles);
+  }
   [[nodiscard]] std::uint16_t last_acked_seq() const noexcept { return last_acked_; }
   [[nodiscard]] const LinkCounters& counters() const noexcept { return counters_; }
   // Seq of the newest command still waiting for its acknowledgement (valid if pending()).

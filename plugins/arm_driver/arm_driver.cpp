@@ -7,7 +7,8 @@
 // (a controller after the driver in the loop is answered in the same cycle).
 // The drive is brought to operation enabled by the driver itself (and fault-reset when it
 // reports a fault); set points reach it only there. A link fault commands quick stop in the
-// same cycle and is reported as Status::degraded with health = fault: the plugin stays
+// same cycle and is reported as Status::device_fault (the host counts a device fault;
+// Status::degraded before the drive first answered) with health = fault: the plugin stays
 // scheduled and recovers by itself, resending the newest set point. No command yet: hold.
 #include <memory>
 #include <string>
@@ -45,7 +46,7 @@ class ArmDriver final : public Plugin {
     }
     state_.safe_state = host_->health() == dr::LinkHealth::fault ? 1 : 0;  // this cycle's write sends quick stop
     state_out_.write(state_, now);
-    return dr::to_plugin_status(host_->health());
+    return dr::to_plugin_status(host_->health(), host_->monitor());
   }
 
   // Write phase: the newest arm_command (this cycle's, or held) goes out with the SYNC.
@@ -62,7 +63,7 @@ class ArmDriver final : public Plugin {
       for (int j = 0; j < ArmCommand::kJoints; ++j) cmd.position_rad[j] = r.status.position_rad[j];
     }
     host_->write_from_rt(cmd, cycle.time_ns);
-    return dr::to_plugin_status(host_->health());
+    return dr::to_plugin_status(host_->health(), host_->monitor());
   }
 
  private:

@@ -25,7 +25,8 @@
 // hand_command, so a controller that runs after the driver in the loop has its command sent in
 // the same cycle as the status it was built from.
 // A link fault (device silent, bus-off, CRC errors, emergency) commands the safe state (hold,
-// zero force) in the same cycle and is reported as Status::degraded with health = fault in
+// zero force) in the same cycle and is reported as Status::device_fault (the host counts a
+// device fault; Status::degraded before the device first answered) with health = fault in
 // hand_state: the plugin stays scheduled so it recovers by itself when the device returns,
 // sending the newest command, never a backlog. Before the first command arrives it holds.
 #include <memory>
@@ -99,7 +100,7 @@ class HandDriver final : public Plugin {
     state_.safe_state = host_->health() == dr::LinkHealth::fault || !enabled ? 1 : 0;
     state_out_.write(state_, now);
 
-    Status status = dr::to_plugin_status(host_->health());
+    Status status = dr::to_plugin_status(host_->health(), host_->monitor());
     if (tactile_) {
       const bool got = tactile_->take_rt(now);
       const dr::tactile::Sample& s = tactile_->sample();
@@ -117,7 +118,7 @@ class HandDriver final : public Plugin {
       for (int f = 0; f < Tactile::kFingertips; ++f)
         for (int t = 0; t < Tactile::kTaxels; ++t) tactile_out_value_.pressure_kpa[f][t] = s.pressure_kpa[f][t];
       tactile_out_.write(tactile_out_value_, now);
-      if (tactile_out_value_.health != DeviceHealth::ok) status = Status::degraded;
+      if (tactile_out_value_.health != DeviceHealth::ok) status = worst(status, Status::degraded);
     }
     return status;
   }
@@ -138,7 +139,7 @@ class HandDriver final : public Plugin {
       for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
     }
     host_->write_from_rt(cmd, stiff, cycle.time_ns);
-    return dr::to_plugin_status(host_->health());
+    return dr::to_plugin_status(host_->health(), host_->monitor());
   }
 
  private:
