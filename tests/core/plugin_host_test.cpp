@@ -199,3 +199,24 @@ TEST_CASE_FIXTURE(Fixture, "unload drives outputs safe and releases the ports") 
   CHECK(wait_for([&] { return read("count").version == 2; }));
   host.stop();
 }
+
+// Several libraries share one plugin name (the misbehaving family is all "test_misbehaving"):
+// the swap event names the library swapped in, by file, and the one it replaced.
+TEST_CASE_FIXTURE(Fixture, "the swap event names the library swapped in and the one it replaced") {
+  host.add_instance(spec("n", "crease_test_noop", 0, "{}", {{"out", "n_out"}}));
+  std::vector<crease::HostEvent> seen;
+  host.set_event_sink([&](const crease::HostEvent& e) { seen.push_back(e); });
+  host.start();
+  host.swap("n", "crease_test_slow");
+  host.swap("n", "crease_test_faulty", crease::Params(YAML::Load("{after: 1000000}"), "test.yaml", "n.params"));
+  host.stop();
+  std::vector<std::string> swaps;
+  for (const auto& e : seen) {
+    if (e.type == crease::HostEvent::Type::swapped) swaps.push_back(e.detail);
+  }
+  REQUIRE(swaps.size() == 2);
+  CHECK(swaps[0].rfind("libcrease_test_slow.so (test_misbehaving 1.0.0) from /", 0) == 0);
+  CHECK(swaps[0].find(", replacing libcrease_test_noop.so") != std::string::npos);
+  CHECK(swaps[1].rfind("libcrease_test_faulty.so (test_misbehaving 1.0.0)", 0) == 0);
+  CHECK(swaps[1].find(", replacing libcrease_test_slow.so") != std::string::npos);
+}

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <exception>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -52,6 +53,54 @@ class DriverPluginRig {
       s = state();
     }
     return s;
+  }
+
+  // The instance as the host sees it, after draining the loop's events.
+  [[nodiscard]] InstanceInfo info() {
+    host.poll();
+    for (InstanceInfo& i : host.instances()) {
+      if (i.name == instance_) return i;
+    }
+    FAIL("no instance " << instance_);
+    return {};
+  }
+  // Polls the host until pred(info()) holds (at most 3 s).
+  template <class P>
+  bool wait_host(P pred) {
+    for (int i = 0; i < 3000; ++i) {
+      if (pred(info())) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return false;
+  }
+
+  // The device stops (its thread ends: silence on the bus) and comes back: the host sees a
+  // device fault (health fault, counted, the instance still active and scheduled) within the
+  // driver's timeout, then its recovery. stop/start: what stops and restarts the device.
+  template <class Stop, class Start>
+  void check_device_fault_and_recovery(Stop stop, Start start) {
+    REQUIRE(wait_host([](const InstanceInfo& i) { return std::string(health_of(i)) == "ok"; }));
+    CHECK(host.device_fault_count() == 0);  // start-up before the first answer is no device fault
+    stop();
+    CHECK(wait_host([](const InstanceInfo& i) { return std::string(health_of(i)) == "fault"; }));
+    const InstanceInfo gone = info();
+    CHECK(gone.state == RunState::active);  // still scheduled: it notices the device's return
+    CHECK(gone.stats->device_faults.load() == 1);
+    CHECK(gone.stats->faults.load() == 0);  // not a firewall fault
+    CHECK(host.device_fault_count() == 1);
+    CHECK(host.devices_in_fault() == 1);
+    CHECK(host.fault_count() == 0);
+    start();
+    CHECK(wait_host([](const InstanceInfo& i) { return std::string(health_of(i)) == "ok"; }));
+    CHECK(host.devices_in_fault() == 0);
+    CHECK(host.device_fault_count() == 1);
+    bool fault_seen = false, recovery_seen = false;
+    for (const HostEvent& e : host.events()) {
+      fault_seen |= e.type == HostEvent::Type::device_fault && e.instance == instance_;
+      recovery_seen |= e.type == HostEvent::Type::device_recovered && e.instance == instance_ && fault_seen;
+    }
+    CHECK(fault_seen);
+    CHECK(recovery_seen);
   }
 
   // A bus nobody serves is a configuration error naming the key and the bus.

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -54,6 +55,24 @@ TEST_CASE("arm_driver: enables the drive, fresh state, no allocation, quick stop
   s = rig.wait_for([](const ArmState& v) { return v.health == DeviceHealth::ok; });
   CHECK(s.health == DeviceHealth::ok);  // re-enabled by the driver after the drive's quick stop
   CHECK(s.fresh == 1);
+  rig.host.stop();
+}
+
+// With the driver reporting a fault link as Status::degraded (as it did), the host counted no
+// device fault and showed the instance healthy: the checks of device_faults and health fail.
+TEST_CASE("arm_driver: a stopped arm is a device fault in the host, and recovers when it runs again") {
+  const std::string bus = "plug-arm-gone-" + std::to_string(::getpid());
+  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
+  dr::MockCanBus dev_bus({bus, 10, 1'000'000, 5'000'000});
+  dr::sim::SimArm arm_dev(dev_bus, {.node = 10});
+  std::optional<dr::sim::DeviceThread> dev;
+  dev.emplace(dev_bus.fd(), [&](std::int64_t t) { arm_dev.step(t); });
+  Rig rig("arm_r", "arm_driver", "arm_state");
+  rig.add("{bus: " + bus + ", node: 10}");
+  rig.host.start();
+  rig.check_device_fault_and_recovery([&] { dev.reset(); },
+                                      [&] { dev.emplace(dev_bus.fd(), [&](std::int64_t t) { arm_dev.step(t); }); });
+  CHECK(rig.state().health == DeviceHealth::ok);
   rig.host.stop();
 }
 

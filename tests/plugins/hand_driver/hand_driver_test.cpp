@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -58,6 +59,24 @@ TEST_CASE("hand_driver: fresh state, no allocation, safe within 3 cycles of sile
   s = rig.wait_for([](const HandState& v) { return v.health == DeviceHealth::ok; });
   CHECK(s.health == DeviceHealth::ok);
   CHECK(s.fresh == 1);
+  rig.host.stop();
+}
+
+// With the driver reporting a fault link as Status::degraded (as it did), the host counted no
+// device fault and showed the instance healthy: the checks of device_faults and health fail.
+TEST_CASE("hand_driver: a stopped hand is a device fault in the host, and recovers when it runs again") {
+  const std::string bus = "plug-hand-gone-" + std::to_string(::getpid());
+  dr::MockCanBroker broker({bus, 1'000'000, 5'000'000, false});
+  dr::MockCanBus dev_bus({bus, 1, 1'000'000, 5'000'000});
+  dr::sim::SimHand hand(dev_bus, {.node = 1});
+  std::optional<dr::sim::DeviceThread> dev;
+  dev.emplace(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
+  Rig rig("hand_r", "hand_driver", "hand_state");
+  rig.add("{bus: " + bus + ", node: 1}");
+  rig.host.start();
+  rig.check_device_fault_and_recovery([&] { dev.reset(); },
+                                      [&] { dev.emplace(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); }); });
+  CHECK(rig.state().health == DeviceHealth::ok);
   rig.host.stop();
 }
 
