@@ -371,3 +371,37 @@ TEST_CASE("daemon.control: the control socket's limits per client, defaults on")
   CHECK(error_of(HEAD "daemon: {control: {rate: 5}}\n").find("daemon.control.rate: unknown key 'rate'") !=
         std::string::npos);
 }
+
+TEST_CASE("the firewall's limits per instance: budget {time_us, cycles} and on_rt_allocation, with safety's default") {
+  const std::string head = HEAD;
+  const auto c = cfg::load_daemon_config_from_string(
+      head + "plugins:\n"
+             "  - {name: a, library: x, loop: control, order: 1, budget: {time_us: 250.5, cycles: 3}}\n"
+             "  - {name: b, library: x, loop: control, order: 2, budget: {time_us: 0}, on_rt_allocation: count}\n"
+             "  - {name: c, library: x, loop: control, order: 3}\n"
+             "safety: {on_rt_allocation: deactivate}\n",
+      "/etc/crease/fw.yaml", kNoDirCheck);
+  REQUIRE(c.plugins.size() == 3);
+  CHECK(*c.plugins[0].budget.time_us == 250.5);
+  CHECK(c.plugins[0].budget.cycles == 3);
+  CHECK(*c.plugins[1].budget.time_us == 0.0);  // no budget
+  CHECK(c.plugins[1].budget.cycles == 20);     // the stated default
+  CHECK(c.plugins[1].on_rt_allocation == cfg::AllocationPolicy::count);
+  CHECK_FALSE(c.plugins[2].budget.time_us.has_value());  // the loop's period
+  CHECK_FALSE(c.plugins[2].on_rt_allocation.has_value());
+  CHECK(c.safety.on_rt_allocation == cfg::AllocationPolicy::deactivate);
+  CHECK(cfg::load_daemon_config_from_string(HEAD, "/etc/crease/fw.yaml", kNoDirCheck).safety.on_rt_allocation ==
+        cfg::AllocationPolicy::count);
+
+  const std::string plugin = head + "plugins:\n  - {name: a, library: x, loop: control, order: 1, ";
+  CHECK(error_of(plugin + "budget: {time_us: -5}}\n") ==
+        "/etc/crease/bad.yaml:7:70: plugins[0].budget.time_us: must be in [0, 1e+07], got -5");
+  CHECK(error_of(plugin + "budget: {cycles: 0}}\n") ==
+        "/etc/crease/bad.yaml:7:69: plugins[0].budget.cycles: must be in [1, 1000000], got 0");
+  CHECK(error_of(plugin + "budget: {tim_us: 5}}\n") ==
+        "/etc/crease/bad.yaml:7:61: plugins[0].budget.tim_us: unknown key 'tim_us' (did you mean 'time_us'?)");
+  CHECK(error_of(plugin + "on_rt_allocation: abort}\n") ==
+        "/etc/crease/bad.yaml:7:70: plugins[0].on_rt_allocation: expected 'count' or 'deactivate', got 'abort'");
+  CHECK(error_of(head + "safety: {on_rt_allocation: 1}\n") ==
+        "/etc/crease/bad.yaml:6:28: safety.on_rt_allocation: expected 'count' or 'deactivate', got '1'");
+}

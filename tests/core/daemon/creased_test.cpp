@@ -19,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/control/control_client.h"
 #include "rt/thread_placement.h"
 
@@ -174,6 +176,10 @@ TEST_CASE("creased runs, creasectl steers it, reports come out in every format")
   CHECK(json.find("hot_swap") != std::string::npos);
   const std::string log = slurp(tmp.path / "creased.log");
   CHECK(log.find("creasectl stop") != std::string::npos);
+  // The swap line names the library swapped in (not only its plugin's name) and the one it replaced.
+  CHECK(log.find("swapped 'counter' in loop 'control': libcrease_test_counter_v2.so (test_counter 2.0.0) from /") !=
+        std::string::npos);
+  CHECK(log.find(", replacing libcrease_test_counter_v1.so") != std::string::npos);
 
   // After it stopped, creasectl says so and exits non-zero.
   auto gone = sh(ctl + "status");
@@ -324,6 +330,78 @@ TEST_CASE("SIGTERM or SIGINT during start-up: creased stops at the next stage, n
     CHECK_FALSE(fs::exists(sock));
     CHECK_FALSE(fs::exists(reports));
   }
+}
+
+// The firewall in the running daemon: a 1500 us plugin in the 1 kHz loop is stopped by its
+// time budget (the loop's period by default); an allocating plugin's heap allocations are
+// counted for it (creased links the allocation hooks), and with on_rt_allocation: deactivate
+// another is stopped. stats, plugins and the report show it.
+TEST_CASE("creased stops a plugin over its time budget and counts an allocating plugin's allocations") {
+  TempDir tmp;
+  const fs::path cfg = tmp.path / "test.yaml";
+  std::ofstream(cfg) << config_text(
+      "  - {name: heavy, library: crease_test_slow, loop: control, order: 2, params: {busy_us: 1500, after: 0},"
+      " ports: {out: heavy_out}}\n"
+      "  - {name: alloc, library: crease_test_allocating, loop: control, order: 3, params: {after: 5},"
+      " ports: {out: alloc_out}}\n"
+      "  - {name: alloc_stop, library: crease_test_allocating, loop: control, order: 4, params: {after: 5},"
+      " ports: {out: alloc_stop_out}, on_rt_allocation: deactivate}\n");
+  const std::string sock = (tmp.path / "creased.sock").string();
+  const fs::path reports = tmp.path / "reports";
+  const pid_t pid = start_creased(tmp.path, cfg, sock, reports);
+  REQUIRE(wait_for_socket(sock));
+  crease::control::ControlClient client(sock);
+  auto plugin = [&](const std::string& name) {
+    const auto r = client.request({{"cmd", "stats"}});
+    for (const auto& p : r["result"]["plugins"]) {
+      if (p["name"] == name) return p;
+    }
+    return nlohmann::json();
+  };
+  bool stopped = false, counted = false;
+  for (int i = 0; i < 400 && !(stopped && counted); ++i) {
+    stopped = plugin("heavy")["state"] == "faulted" && plugin("alloc_stop")["state"] == "faulted";
+    counted = plugin("alloc")["rt_allocations"].get<std::uint64_t>() > 100;
+    std::this_thread::sleep_for(25ms);
+  }
+  CHECK(stopped);
+  CHECK(counted);
+  const auto stats = client.request({{"cmd", "stats"}})["result"];
+  CHECK(stats["rt_allocations"]["counted"] == true);
+  CHECK(stats["faults"] == 2);
+  CHECK(plugin("heavy")["over_budget"].get<std::uint64_t>() >= 20);
+  CHECK(plugin("heavy")["rt_allocations"] == 0);
+  CHECK(plugin("alloc")["state"] == "active");  // safety.on_rt_allocation: count (the default)
+  CHECK(plugin("alloc_stop")["rt_allocations"] == 1);
+  CHECK(plugin("counter")["rt_allocations"] == 0);
+  CHECK(plugin("counter")["state"] == "active");
+  const auto plugins = client.request({{"cmd", "plugins"}})["result"];
+  for (const auto& p : plugins) {
+    if (p["name"] == "heavy") {
+      CHECK(p["budget_us"] == 1000.0);
+      CHECK(p["budget_cycles"] == 20);
+      CHECK(p["last_fault"] == "ran over its time budget");
+    }
+  }
+  CHECK(sh(kBin + "/creasectl --socket " + sock + " stop").status == 0);
+  int wstatus = 0;
+  for (int i = 0; i < 200; ++i) {
+    if (waitpid(pid, &wstatus, WNOHANG) == pid) break;
+    std::this_thread::sleep_for(25ms);
+  }
+  REQUIRE(WIFEXITED(wstatus));
+  const std::string log = slurp(tmp.path / "creased.log");
+  CHECK(log.find("instance 'heavy' in loop 'control' ran over its time budget (1000 us) for 20 consecutive cycles") !=
+        std::string::npos);
+  const auto report = nlohmann::json::parse(slurp(reports / "report.json"));
+  std::uint64_t alloc_in_report = 0;
+  for (const auto& l : report["loops"]) {
+    for (const auto& p : l["plugins"]) {
+      if (p["name"] == "alloc") alloc_in_report = p["rt_allocations"].get<std::uint64_t>();
+    }
+  }
+  CHECK(alloc_in_report > 100);
+  CHECK(slurp(reports / "report.txt").find("rt_allocations=") != std::string::npos);
 }
 
 TEST_CASE("bad configurations exit 2 with file, line and key, and start nothing") {
