@@ -1,14 +1,19 @@
 // crease-bench overhead: what the framework costs per cycle of a loop running 10 no-op plugins
 // (schedule walk, state checks, tunables, per-plugin timing, the C ABI call), beside the same
-// 10 no-op calls made through plain virtual functions in the same run.
+// 10 no-op calls made through plain virtual functions in the same run; then what counting the
+// plugins' heap allocations adds (the loop reads its thread's allocation counter before and
+// after each hook), with and without it in interleaved turns so a neighbour's load falls on
+// both alike, and what the counting operator new adds to one allocation off the RT threads.
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <vector>
 
 #include "bench_registry.h"
 #include "bench_util.h"
 #include "core/plugin_host.h"
+#include "rt/alloc_guard.h"
 #include "rt/clock.h"
 
 namespace {
@@ -19,6 +24,40 @@ struct Base {
 struct Noop final : Base {
   int update(const crease::rt::CycleClock& c) noexcept override { return static_cast<int>(c.cycle & 0); }
 };
+
+double ns_per(std::chrono::steady_clock::duration d, std::uint64_t n) {
+  return std::chrono::duration<double, std::nano>(d).count() / double(n);
+}
+
+// new/delete (the counting hooks: crease-bench links them, as creased does) against
+// malloc/free, on a thread that is not RT-marked; interleaved turns.
+void allocation_hook_cost(std::uint64_t n) {
+  constexpr int kTurns = 10;
+  std::chrono::steady_clock::duration hooked{}, plain{};
+  void* volatile keep = nullptr;
+  for (int turn = 0; turn < kTurns; ++turn) {
+    auto t0 = std::chrono::steady_clock::now();
+    for (std::uint64_t i = 0; i < n / kTurns; ++i) {
+      int* p = new int(static_cast<int>(i));
+      keep = p;
+      delete p;
+    }
+    auto t1 = std::chrono::steady_clock::now();
+    for (std::uint64_t i = 0; i < n / kTurns; ++i) {
+      void* p = std::malloc(sizeof(int));
+      keep = p;
+      std::free(p);
+    }
+    auto t2 = std::chrono::steady_clock::now();
+    hooked += t1 - t0;
+    plain += t2 - t1;
+  }
+  (void)keep;
+  const double h = ns_per(hooked, n), m = ns_per(plain, n);
+  std::printf("  new + delete through the counting hooks (non-RT thread): %6.1f ns; malloc + free: %6.1f ns; hook: %+.1f ns\n",
+              h, m, h - m);
+  std::printf("overhead_alloc_hook: hooked_ns=%.1f malloc_ns=%.1f hook_ns=%.1f\n", h, m, h - m);
+}
 
 int run(int argc, char** argv) {
   const auto cycles = static_cast<std::uint64_t>(crease::bench::arg_double(argc, argv, "--cycles", 2e6));
@@ -55,6 +94,33 @@ int run(int argc, char** argv) {
               (ours_ns - plain_ns) / 10.0);
   std::printf("overhead: ours_ns_per_cycle=%.1f plain_ns_per_cycle=%.1f framework_ns=%.1f plugins=10\n", ours_ns,
               plain_ns, ours_ns - plain_ns);
+
+  // Allocation counting on and off, in turns, on an RT-marked thread (as a loop's).
+  {
+    const crease::rt::ScopedRtMark rt_mark;
+    constexpr int kTurns = 10;
+    std::chrono::steady_clock::duration on{}, off{};
+    std::uint64_t c = 0;
+    for (int turn = 0; turn < kTurns; ++turn) {
+      for (const bool counting : {true, false}) {
+        loop.set_count_allocations(counting);
+        const auto a = std::chrono::steady_clock::now();
+        for (std::uint64_t i = 0; i < cycles / kTurns; ++i) {
+          clock.cycle = c++;
+          loop.run_cycle_rt(clock);
+        }
+        (counting ? on : off) += std::chrono::steady_clock::now() - a;
+      }
+    }
+    loop.set_count_allocations(true);
+    const double on_ns = ns_per(on, cycles), off_ns = ns_per(off, cycles);
+    std::printf("  allocation counting on: %8.1f ns per cycle; off: %8.1f ns per cycle; counting: %+.1f ns per cycle "
+                "(%+.2f ns per plugin)\n",
+                on_ns, off_ns, on_ns - off_ns, (on_ns - off_ns) / 10.0);
+    std::printf("overhead_alloc_count: on_ns_per_cycle=%.1f off_ns_per_cycle=%.1f counting_ns=%.1f plugins=10\n", on_ns,
+                off_ns, on_ns - off_ns);
+  }
+  allocation_hook_cost(cycles * 5);
   return 0;
 }
 }  // namespace
