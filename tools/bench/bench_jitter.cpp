@@ -108,8 +108,10 @@ int run(int argc, char** argv) {
   print_step(mem);
   crease::PluginHost background({CREASE_PLUGIN_DIR});
   background.add_loop({"vision", 15.0, 0, -1});
-  background.add_instance(crease::bench::instance("burn", "crease_test_slow", "vision",
-                                   "{busy_us: " + std::to_string(std::lround(background_ms * 1000)) + "}"));
+  crease::InstanceSpec burn = crease::bench::instance("burn", "crease_test_slow", "vision",
+                                                     "{busy_us: " + std::to_string(std::lround(background_ms * 1000)) + "}");
+  burn.budget_ns = 0;  // the neighbour burns on, whatever --background-ms (no time budget)
+  background.add_instance(burn);
   background.start();
   std::printf("jitter: background: a 15 Hz loop burning %.0f ms per cycle; %d turns of %.1f s each for Crease "
               "(1 kHz, priority %d) and cyclictest (-m -p %d -i 1000)\n",
