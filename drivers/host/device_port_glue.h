@@ -24,14 +24,31 @@ namespace crease::drivers {
   return DeviceHealth::fault;
 }
 
-// A plugin stays scheduled through link faults (it recovers by itself): a `fault` health after
-// start-up (monitor.past_start_up()) is Status::device_fault, which the host counts as a device
-// fault and shows as the instance's health until the link is ok or degraded again; before
-// first contact, and for a degraded link, Status::degraded. Never Status::fault.
-[[nodiscard]] inline Status to_plugin_status(LinkHealth h, const LinkMonitor& monitor) noexcept {
-  if (h == LinkHealth::ok) return Status::ok;
-  return h == LinkHealth::fault && monitor.past_start_up() ? Status::device_fault : Status::degraded;
-}
+// A plugin stays scheduled through link faults (it recovers by itself); what it returns to the
+// host, once per cycle. A `fault` health that lasted device_fault_cycles consecutive cycles
+// after start-up (LinkMonitor::past_start_up) is Status::device_fault: the host counts a device
+// fault and shows it as the instance's health until the link is ok or degraded again. A
+// shorter fault (the safe state is commanded all the same), a degraded link and a link before
+// first contact are Status::degraded; ok is ok. Never Status::fault. RT-safe.
+class DeviceFaultReport {
+ public:
+  explicit DeviceFaultReport(int device_fault_cycles = 50) noexcept : cycles_(device_fault_cycles) {}
+  // The read phase's verdict, after the host read the bus.
+  Status update(LinkHealth h, const LinkMonitor& monitor) noexcept {
+    fault_run_ = h == LinkHealth::fault ? fault_run_ + 1 : 0;
+    if (h == LinkHealth::ok) status_ = Status::ok;
+    else if (fault_run_ >= cycles_ && monitor.past_start_up()) status_ = Status::device_fault;
+    else status_ = Status::degraded;
+    return status_;
+  }
+  // This cycle's verdict again (the write phase).
+  [[nodiscard]] Status status() const noexcept { return status_; }
+
+ private:
+  int cycles_;
+  int fault_run_ = 0;  // consecutive cycles in fault
+  Status status_ = Status::degraded;
+};
 
 // Configure time: the node (`node`, 1..126), the link monitor and the bus the parameters name
 // (link_params.h) into a HandHostConfig / ArmHostConfig. Throws ConfigError on a bad value.

@@ -23,6 +23,10 @@ struct LinkMonitorConfig {
   // Start-up: cycles the device has to answer a first time before its silence counts as a
   // device fault (a link that never answered is `fault` but not yet reported as gone).
   int first_contact_cycles = 1000;
+  // Consecutive cycles in `fault` before the driver reports the device as gone
+  // (Status::device_fault, device_port_glue.h): shorter gaps command the safe state all the
+  // same but are no device fault (a loaded machine's late answers are not a lost device).
+  int device_fault_cycles = 50;
 };
 
 struct LinkCounters {

@@ -37,6 +37,7 @@ LinkMonitorConfig monitor_from_params(const Params& p) {
   LinkMonitorConfig m;
   m.timeout_cycles = p.get_in_range<int>("timeout_cycles", 2, 1, 100);
   m.crc_threshold = p.get_in_range<int>("crc_threshold", 10, 0, 1000);
+  m.device_fault_cycles = p.get_in_range<int>("device_fault_cycles", 50, 1, 1'000'000);
   return m;
 }
 

@@ -2,13 +2,14 @@
 //   input  arm_command (latest ArmCommand)
 //   output arm_state   (latest ArmState: positions, velocities, drive state, health, acks)
 // Parameters: bus_kind ("mock" | "socketcan"), bus (required), node (required, 1..126),
-//   host_node (mock, default 100), timeout_cycles (2), crc_threshold (10).
+//   host_node (mock, default 100), timeout_cycles (2), crc_threshold (10), device_fault_cycles (50).
 // Cycle phases: update reads the bus and publishes arm_state; write sends the newest arm_command
 // (a controller after the driver in the loop is answered in the same cycle).
 // The drive is brought to operation enabled by the driver itself (and fault-reset when it
 // reports a fault); set points reach it only there. A link fault commands quick stop in the
-// same cycle and is reported as Status::device_fault (the host counts a device fault;
-// Status::degraded before the drive first answered) with health = fault: the plugin stays
+// same cycle and is reported as Status::degraded, and as Status::device_fault once it lasted
+// device_fault_cycles (the host counts a device fault; never before the drive first answered),
+// with health = fault: the plugin stays
 // scheduled and recovers by itself, resending the newest set point. No command yet: hold.
 #include <memory>
 #include <string>
@@ -27,6 +28,7 @@ class ArmDriver final : public Plugin {
   void configure(const Params& p, PortBinder& ports) override {
     dr::ArmHostConfig cfg;
     bus_ = dr::configure_can_device(p, cfg, 10);
+    report_ = dr::DeviceFaultReport(cfg.monitor.device_fault_cycles);
     host_ = std::make_unique<dr::ArmHost>(*bus_, cfg);
     command_ = ports.latest_input<ArmCommand>("arm_command");
     state_out_ = ports.latest_output<ArmState>("arm_state", ArmState{});
@@ -46,7 +48,7 @@ class ArmDriver final : public Plugin {
     }
     state_.safe_state = host_->health() == dr::LinkHealth::fault ? 1 : 0;  // this cycle's write sends quick stop
     state_out_.write(state_, now);
-    return dr::to_plugin_status(host_->health(), host_->monitor());
+    return report_.update(host_->health(), host_->monitor());
   }
 
   // Write phase: the newest arm_command (this cycle's, or held) goes out with the SYNC.
@@ -63,11 +65,12 @@ class ArmDriver final : public Plugin {
       for (int j = 0; j < ArmCommand::kJoints; ++j) cmd.position_rad[j] = r.status.position_rad[j];
     }
     host_->write_from_rt(cmd, cycle.time_ns);
-    return dr::to_plugin_status(host_->health(), host_->monitor());
+    return report_.status();
   }
 
  private:
   std::unique_ptr<dr::CanBus> bus_;
+  dr::DeviceFaultReport report_;
   std::unique_ptr<dr::ArmHost> host_;
   LatestInput<ArmCommand> command_;
   LatestOutput<ArmState> state_out_;

@@ -18,6 +18,7 @@
 //   tactile_rate_hz 1..1000 (default 250)
 //   timeout_cycles  cycles without a fresh status before fault (default 2)
 //   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
+//   device_fault_cycles cycles in fault before it is reported as a device fault (default 50)
 // Threads: the tactile link's reader thread ("crease-tactile", on the non-RT CPUs) runs from
 // activate to deactivate: it sends Start, deframes and decodes, and queues every sample.
 // Cycle phases: update reads the bus, takes the queued tactile samples and publishes
@@ -25,8 +26,9 @@
 // hand_command, so a controller that runs after the driver in the loop has its command sent in
 // the same cycle as the status it was built from.
 // A link fault (device silent, bus-off, CRC errors, emergency) commands the safe state (hold,
-// zero force) in the same cycle and is reported as Status::device_fault (the host counts a
-// device fault; Status::degraded before the device first answered) with health = fault in
+// zero force) in the same cycle and is reported as Status::degraded, and as Status::device_fault
+// once it lasted device_fault_cycles (the host counts a device fault; never before the device
+// first answered) with health = fault in
 // hand_state: the plugin stays scheduled so it recovers by itself when the device returns,
 // sending the newest command, never a backlog. Before the first command arrives it holds.
 #include <memory>
@@ -51,6 +53,7 @@ class HandDriver final : public Plugin {
   void configure(const Params& p, PortBinder& ports) override {
     dr::HandHostConfig cfg;
     bus_ = dr::configure_can_device(p, cfg, 1);
+    report_ = dr::DeviceFaultReport(cfg.monitor.device_fault_cycles);
     cfg.pressure_sensors = p.get<bool>("pressure_sensors", false);
     host_ = std::make_unique<dr::HandHost>(*bus_, cfg);
     if (p.has("tactile_device")) {
@@ -100,7 +103,7 @@ class HandDriver final : public Plugin {
     state_.safe_state = host_->health() == dr::LinkHealth::fault || !enabled ? 1 : 0;
     state_out_.write(state_, now);
 
-    Status status = dr::to_plugin_status(host_->health(), host_->monitor());
+    Status status = report_.update(host_->health(), host_->monitor());
     if (tactile_) {
       const bool got = tactile_->take_rt(now);
       const dr::tactile::Sample& s = tactile_->sample();
@@ -139,11 +142,12 @@ class HandDriver final : public Plugin {
       for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
     }
     host_->write_from_rt(cmd, stiff, cycle.time_ns);
-    return dr::to_plugin_status(host_->health(), host_->monitor());
+    return report_.status();
   }
 
  private:
   std::unique_ptr<dr::CanBus> bus_;
+  dr::DeviceFaultReport report_;
   std::unique_ptr<dr::HandHost> host_;
   std::unique_ptr<dr::SerialPort> serial_;
   std::unique_ptr<dr::TactileReader> tactile_;  // after serial_: stopped before the port closes
