@@ -36,19 +36,21 @@ TEST_CASE("each thread has its own count, of its RT-marked allocations only") {
   auto not_counted = std::make_unique<int>(0);  // not RT-marked
   CHECK(*mine == before);
   std::uint64_t other_count = 99;
+  std::vector<std::unique_ptr<int>> kept;  // escapes: the allocations cannot be elided
+  kept.reserve(3);
   std::thread([&] {
     crease::rt::ScopedRtMark mark;
     const std::uint64_t* theirs = crease::rt::this_thread_rt_allocations();
     const std::uint64_t at_start = *theirs;
-    auto a = std::make_unique<int>(1);
-    auto b = std::make_unique<int>(2);
+    kept.push_back(std::make_unique<int>(1));
+    kept.push_back(std::make_unique<int>(2));
     other_count = *theirs - at_start;
   }).join();
   CHECK(other_count == 2);
   CHECK(*mine == before);  // the other thread's allocations are not this one's
   {
     crease::rt::ScopedRtMark mark;
-    auto c = std::make_unique<int>(3);
+    kept.push_back(std::make_unique<int>(3));  // within the reserved capacity: one allocation
     CHECK(*mine == before + 1);
   }
 }

@@ -63,6 +63,10 @@ TEST_CASE("four driver plugins in the control loop against four device processes
   const HandState hl = read_port<HandState>(host, "hand_l.hand_state");
   const ArmState a1 = read_port<ArmState>(host, "arm_r.arm_state");
   const ArmState al = read_port<ArmState>(host, "arm_l.arm_state");
+  for (const auto& i : host.instances()) {  // what the firewall made of each, should a check below fail
+    MESSAGE(i.name << ": " << std::string(to_string(i.state)) << ", last fault " << std::string(to_string(i.last_fault))
+                   << ", device faults " << i.stats->device_faults.load() << ", over budget " << i.stats->over_budget.load());
+  }
   host.stop();
   const auto sent_h = h1.commands_sent - h0.commands_sent;
   const auto sent_a = a1.commands_sent - a0.commands_sent;
