@@ -4,6 +4,7 @@
 // plugins' heap allocations adds (the loop reads its thread's allocation counter before and
 // after each hook), with and without it in interleaved turns so a neighbour's load falls on
 // both alike, and what the counting operator new adds to one allocation off the RT threads.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -95,30 +96,39 @@ int run(int argc, char** argv) {
   std::printf("overhead: ours_ns_per_cycle=%.1f plain_ns_per_cycle=%.1f framework_ns=%.1f plugins=10\n", ours_ns,
               plain_ns, ours_ns - plain_ns);
 
-  // Allocation counting on and off, in turns, on an RT-marked thread (as a loop's).
+  // Allocation counting on and off, in 40 paired turns, on an RT-marked thread (as a loop's):
+  // the median of the pairs' differences, so a neighbour's burst spoils a few pairs, not the figure.
   {
     const crease::rt::ScopedRtMark rt_mark;
-    constexpr int kTurns = 10;
-    std::chrono::steady_clock::duration on{}, off{};
+    constexpr int kTurns = 40;
+    std::vector<double> on_ns, off_ns, diff_ns;
     std::uint64_t c = 0;
     for (int turn = 0; turn < kTurns; ++turn) {
-      for (const bool counting : {true, false}) {
+      double pair[2] = {0, 0};
+      for (const bool counting : {turn % 2 == 0, turn % 2 != 0}) {  // alternate which goes first
         loop.set_count_allocations(counting);
         const auto a = std::chrono::steady_clock::now();
         for (std::uint64_t i = 0; i < cycles / kTurns; ++i) {
           clock.cycle = c++;
           loop.run_cycle_rt(clock);
         }
-        (counting ? on : off) += std::chrono::steady_clock::now() - a;
+        pair[counting ? 0 : 1] = ns_per(std::chrono::steady_clock::now() - a, cycles / kTurns);
       }
+      on_ns.push_back(pair[0]);
+      off_ns.push_back(pair[1]);
+      diff_ns.push_back(pair[0] - pair[1]);
     }
     loop.set_count_allocations(true);
-    const double on_ns = ns_per(on, cycles), off_ns = ns_per(off, cycles);
-    std::printf("  allocation counting on: %8.1f ns per cycle; off: %8.1f ns per cycle; counting: %+.1f ns per cycle "
-                "(%+.2f ns per plugin)\n",
-                on_ns, off_ns, on_ns - off_ns, (on_ns - off_ns) / 10.0);
-    std::printf("overhead_alloc_count: on_ns_per_cycle=%.1f off_ns_per_cycle=%.1f counting_ns=%.1f plugins=10\n", on_ns,
-                off_ns, on_ns - off_ns);
+    auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    const double on = median(on_ns), off = median(off_ns), d = median(diff_ns);
+    std::printf("  allocation counting on: %8.1f ns per cycle; off: %8.1f ns per cycle (medians of %d turns); "
+                "counting: %+.1f ns per cycle (median of the pairs' differences, %+.2f ns per plugin)\n",
+                on, off, kTurns, d, d / 10.0);
+    std::printf("overhead_alloc_count: on_ns_per_cycle=%.1f off_ns_per_cycle=%.1f counting_ns=%.1f plugins=10\n", on, off,
+                d);
   }
   allocation_hook_cost(cycles * 5);
   return 0;
