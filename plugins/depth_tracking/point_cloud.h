@@ -1,0 +1,82 @@
+// World-frame point clouds from registered depth + colour images (seed 001 Sec. III-B): a
+// pixel becomes a point when its colour lies in the HSV range of the sheet AND its depth is
+// valid; it is back-projected through the calibrated camera (plugins/camera_rig, distortion
+// included, depth = z along the optical axis), then the fused cloud is voxel-downsampled.
+//
+// configure() allocates everything (the per-pixel ray tables of each camera, the point buffer
+// of max_points); clear()/add_view()/voxel_downsample() allocate nothing and throw nothing.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "plugins/camera_rig/camera_model.h"
+
+namespace crease::depth {
+
+// OpenCV's 8-bit HSV: h in [0, 180) (degrees / 2), s and v in [0, 255]. h_lo > h_hi wraps
+// through 0 (reds).
+struct HsvRange {
+  int h_lo = 0, h_hi = 179;
+  int s_lo = 0, s_hi = 255;
+  int v_lo = 0, v_hi = 255;
+  [[nodiscard]] bool contains(int h, int s, int v) const noexcept {
+    const bool h_in = h_lo <= h_hi ? (h >= h_lo && h <= h_hi) : (h >= h_lo || h <= h_hi);
+    return h_in && s >= s_lo && s <= s_hi && v >= v_lo && v <= v_hi;
+  }
+};
+
+// BGR (8 bit) -> OpenCV 8-bit HSV, as cv::cvtColor(COLOR_BGR2HSV). RT-safe.
+void bgr_to_hsv(std::uint8_t b, std::uint8_t g, std::uint8_t r, int& h, int& s, int& v) noexcept;
+
+struct CloudParams {
+  HsvRange mask;
+  double depth_unit_mm = 1.0;   // one depth count in mm (D435 default 1 mm, D405 0.1 mm)
+  double min_depth_mm = 100.0;  // valid depth range along the optical axis, mm
+  double max_depth_mm = 3000.0;
+  double voxel_mm = 5.0;        // leaf size of the voxel grid, mm (> 0)
+};
+
+struct CloudCounters {
+  std::int64_t pixels = 0;         // pixels looked at
+  std::int64_t masked_out = 0;     // colour outside the range
+  std::int64_t invalid_depth = 0;  // colour in range, depth 0 or out of range
+  std::int64_t overflow = 0;       // points lost because the buffer was full
+};
+
+class CloudBuilder {
+ public:
+  // Non-RT. Throws crease::ConfigError naming the field on a bad range; one ray table per
+  // camera (its pixel grid undistorted once).
+  void configure(const CloudParams& params, const std::vector<vision::Camera>& cameras,
+                 int max_points);
+
+  void clear() noexcept;  // empties the cloud and the counters
+  // Adds the masked, valid pixels of camera `cam`'s view: depth CV_16UC1 in depth units, colour
+  // CV_8UC3 BGR registered to it, both the camera's size. False (nothing added) on a wrong
+  // index, size or type. RT-safe.
+  bool add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) noexcept;
+  // Replaces the cloud by one point per occupied voxel (the mean of its points); the order is
+  // that of the voxel keys (deterministic). RT-safe.
+  void voxel_downsample() noexcept;
+
+  [[nodiscard]] std::span<const Eigen::Vector3d> points() const noexcept {
+    return {points_.data(), static_cast<std::size_t>(count_)};
+  }
+  [[nodiscard]] const CloudCounters& counters() const noexcept { return counters_; }
+
+ private:
+  CloudParams params_;
+  std::vector<vision::Camera> cameras_;
+  std::vector<std::vector<cv::Vec2f>> rays_;  // per camera, per pixel: undistorted (x/z, y/z)
+  std::vector<Eigen::Vector3d> points_;       // capacity max_points
+  std::vector<std::uint64_t> keys_;           // voxel key << 32 | point index, capacity max_points
+  int count_ = 0;
+  CloudCounters counters_;
+};
+
+}  // namespace crease::depth
