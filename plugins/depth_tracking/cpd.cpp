@@ -10,7 +10,11 @@
 namespace crease::depth {
 namespace {
 
-constexpr double kMinP1 = 1e-12;  // a node no point supports gets a huge d(P1)^-1, W_m ~ 0
+constexpr double kMinP1 = 1e-12;
+// Kernel values below exp(-40) (4e-18, below double rounding of any sum with a nearer node or
+// the outlier term) are taken as zero without calling exp: most node-point pairs of a sheet.
+// (With w = 0 a point farther than that from every node then has no posterior at all.)
+constexpr double kMaxExponent = 40.0;  // a node no point supports gets a huge d(P1)^-1, W_m ~ 0
 
 void check(bool ok, const char* key, const std::string& reason) {
   if (!ok) throw ConfigError(std::string("depth_tracking: ") + key + ": " + reason);
@@ -58,7 +62,8 @@ double NonRigidCpd::e_step(int m, int n, double sigma2) noexcept {
     double den = c;
     for (int i = 0; i < m; ++i) {
       const double dx = xx - y_(i, 0), dy = xy - y_(i, 1), dz = xz - y_(i, 2);
-      const double k = std::exp(-(dx * dx + dy * dy + dz * dz) * inv2s);
+      const double e = (dx * dx + dy * dy + dz * dz) * inv2s;
+      const double k = e < kMaxExponent ? std::exp(-e) : 0.0;
       k_[i] = k;
       den += k;
     }
