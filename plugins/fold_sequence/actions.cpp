@@ -18,18 +18,27 @@ void set_limits(ArmGoal& g, const MotionLimits& l) noexcept {
   g.stop_accel_mm_s2 = l.stop_accel_mm_s2;
 }
 
+// The next arm goal of SIDE in the outbox, cleared, stamped and numbered; null (overflow marked)
+// when the side's goals of this step are full.
+ArmGoal* next_arm_goal(int side, std::int64_t t_ns, std::uint32_t& next_id, Outbox& out) noexcept {
+  if (out.arm_count[side] >= Outbox::kPerPort) {
+    out.overflow = true;
+    return nullptr;
+  }
+  ArmGoal& g = out.arm[side][out.arm_count[side]++];
+  g = ArmGoal{};
+  g.timestamp_ns = t_ns;
+  g.id = next_id++;
+  return &g;
+}
+
 }  // namespace
 
 void Machine::arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                        const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept {
-  if (out.arm_count[side] >= Outbox::kPerPort) {
-    out.overflow = true;
-    return;
-  }
-  ArmGoal& g = out.arm[side][out.arm_count[side]++];
-  g = ArmGoal{};
-  g.timestamp_ns = m_.last_ns;
-  g.id = m_.next_id++;
+  ArmGoal* goal = next_arm_goal(side, m_.last_ns, m_.next_id, out);
+  if (goal == nullptr) return;
+  ArmGoal& g = *goal;
   g.kind = ArmGoal::move;
   g.tool = tool;
   g.frame = frame;
@@ -48,15 +57,9 @@ void Machine::arm_move(int side, std::uint8_t tool, std::uint8_t frame, const do
 }
 
 void Machine::arm_stop(int side, Outbox& out) noexcept {
-  if (out.arm_count[side] >= Outbox::kPerPort) {
-    out.overflow = true;
-    return;
-  }
-  ArmGoal& g = out.arm[side][out.arm_count[side]++];
-  g = ArmGoal{};
-  g.timestamp_ns = m_.last_ns;
-  g.id = m_.next_id++;
-  g.kind = ArmGoal::stop;
+  ArmGoal* g = next_arm_goal(side, m_.last_ns, m_.next_id, out);
+  if (g == nullptr) return;
+  g->kind = ArmGoal::stop;
   m_.arm_id[side] = 0;  // a stop is not waited for by id: the arm is still when it no longer moves
 }
 

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "plugins/robot_model/arm_ik.h"
+#include "plugins/sim_world/reference_poses.h"
 #include "plugins/sim_world/side_kinematics.h"
 
 namespace crease::bench::world_scene {
@@ -20,9 +21,7 @@ using world::SideKinematics;
 
 double deg(double d) { return d * std::numbers::pi / 180.0; }
 
-// Hand joint indices (drivers/README.md §3).
-enum HandJoint { WRJ2, WRJ1, FFJ4, FFJ3, FFJ2, MFJ4, MFJ3, MFJ2, RFJ4, RFJ3, RFJ2, LFJ5, LFJ4, LFJ3, LFJ2,
-                 THJ5, THJ4, THJ3, THJ2, THJ1 };
+using namespace crease::world::poses;
 
 KDL::Rotation frame_from_z_x(KDL::Vector z, KDL::Vector x) {
   z.Normalize();
@@ -33,27 +32,6 @@ KDL::Rotation frame_from_z_x(KDL::Vector z, KDL::Vector x) {
 KDL::Frame to_frame(const Pose& p) {
   return KDL::Frame(KDL::Rotation(p.r[0], p.r[1], p.r[2], p.r[3], p.r[4], p.r[5], p.r[6], p.r[7], p.r[8]),
                     KDL::Vector(p.t.x, p.t.y, p.t.z) / 1000.0);
-}
-
-// Only the index out: the other fingers bent back to their J3 limit (-15 deg).
-HandQ index_out() {
-  HandQ h{};
-  h[MFJ3] = h[RFJ3] = h[LFJ3] = deg(-15);
-  return h;
-}
-
-// The sim_world pinch test's pinch: index curled pad up, the thumb closing on it (THJ5 0.3 open).
-HandQ pinch_hand(double thj5) {
-  HandQ h = index_out();
-  h[FFJ4] = 0.201;
-  h[FFJ3] = 1.428;
-  h[FFJ2] = 0.321;
-  h[THJ5] = thj5;
-  h[THJ4] = 1.072;
-  h[THJ3] = 0.027;
-  h[THJ2] = -0.549;
-  h[THJ1] = -0.117;
-  return h;
 }
 
 // A side's tool path: the index pad's point (mm) and the hand's angles at every step.

@@ -6,26 +6,15 @@
 #include <cmath>
 #include <string>
 
+#include "plugins/sim_world/reference_poses.h"
 #include "scene.h"
 
 using namespace scene;
 
 namespace {
 
-// The pinch found by a search over the index's and thumb's joints (pads facing, 4 mm apart at
-// THJ5 0.696); THJ5 opens (0.3) and closes it.
-HandQ pinch_hand(double thj5) {
-  HandQ h = index_out();
-  h[FFJ4] = 0.201;
-  h[FFJ3] = 1.428;
-  h[FFJ2] = 0.321;
-  h[THJ5] = thj5;
-  h[THJ4] = 1.072;
-  h[THJ3] = 0.027;
-  h[THJ2] = -0.549;
-  h[THJ1] = -0.117;
-  return h;
-}
+// The pinch (plugins/sim_world/reference_poses.h): THJ5 0.3 open, 0.696 pads 4 mm apart.
+using crease::world::poses::pinch_hand;
 
 // The palm hanging down, turned so that the thumb pad faces straight down onto the index pad.
 KDL::Rotation pinch_palm(const HandQ& h) {
