@@ -60,6 +60,9 @@ TEST_CASE("a recording made 2000 s ago plays with fresh stamps, its intervals ke
   ReplaySource src(make_recording("old", recorded));
   REQUIRE(src.frames() == 4);
   CHECK(src.start_ns() == 0);  // not started before the first grab
+  // All four decoded first, so that only this thread's own scheduling can make a frame late.
+  for (int i = 0; i < 2000 && src.queued() < 4; ++i) std::this_thread::sleep_for(2ms);
+  CHECK(src.start_ns() == 0);
   const std::int64_t before = crease::rt::now_ns();
   Frame f;
   std::vector<std::int64_t> stamps;
@@ -80,8 +83,18 @@ TEST_CASE("a recording made 2000 s ago plays with fresh stamps, its intervals ke
   CHECK(stamps[0] >= before);
   CHECK(stamps[3] <= after);
   CHECK(stamps[0] - recorded[0] > 1900 * kS);  // the recorded stamps would be 2000 s old
-  // ...and every frame its recorded interval after it.
-  for (std::size_t i = 0; i < 4; ++i) CHECK(stamps[i] - stamps[0] == recorded[i] - recorded[0]);
+  // ...and every frame its recorded interval after it; a frame handed out late (this thread
+  // preempted past its successor's time on a loaded machine) moves the start, so the rest keep
+  // their intervals from it, never closer than recorded.
+  for (std::size_t i = 1; i < 4; ++i) {
+    CAPTURE(i);
+    if (src.late() == 0) {
+      CHECK(stamps[i] - stamps[0] == recorded[i] - recorded[0]);
+    } else {
+      CHECK(stamps[i] - stamps[i - 1] >= recorded[i] - recorded[i - 1]);
+    }
+  }
+  if (src.late() != 0) MESSAGE(src.late() << " of 4 frames handed out late (a loaded machine)");
   CHECK(src.played() == 4);
 }
 
