@@ -46,9 +46,14 @@ std::string make_recording(const std::string& name, const std::vector<std::int64
   return dir.string();
 }
 
+// A thread of this process is named NAME, within 4 s (a decoder names itself when it first
+// runs, which on a loaded machine may be after the others filled the queue).
 bool thread_named(const std::string& name) {
-  for (const crease::rt::ThreadInfo& t : crease::rt::list_threads())
-    if (t.name == name) return true;
+  for (int i = 0; i < 2000; ++i) {
+    for (const crease::rt::ThreadInfo& t : crease::rt::list_threads())
+      if (t.name == name) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
   return false;
 }
 }  // namespace
