@@ -82,7 +82,11 @@ class DriverPluginRig {
     REQUIRE(wait_host([](const InstanceInfo& i) { return std::string(health_of(i)) == "ok"; }));
     CHECK(host.device_fault_count() == 0);  // start-up before the first answer is no device fault
     stop();
-    CHECK(wait_host([](const InstanceInfo& i) { return std::string(health_of(i)) == "fault"; }));
+    // The health (the loop's last status) may be seen a moment before the loop's event reaches
+    // the host: wait for both.
+    CHECK(wait_host([this](const InstanceInfo& i) {
+      return std::string(health_of(i)) == "fault" && host.device_fault_count() >= 1;
+    }));
     const InstanceInfo gone = info();
     CHECK(gone.state == RunState::active);  // still scheduled: it notices the device's return
     CHECK(gone.stats->device_faults.load() == 1);
@@ -91,14 +95,19 @@ class DriverPluginRig {
     CHECK(host.devices_in_fault() == 1);
     CHECK(host.fault_count() == 0);
     start();
-    CHECK(wait_host([](const InstanceInfo& i) { return std::string(health_of(i)) == "ok"; }));
+    bool fault_seen = false, recovery_seen = false;
+    const auto scan_events = [&] {
+      fault_seen = recovery_seen = false;
+      for (const HostEvent& e : host.events()) {
+        fault_seen |= e.type == HostEvent::Type::device_fault && e.instance == instance_;
+        recovery_seen |= e.type == HostEvent::Type::device_recovered && e.instance == instance_ && fault_seen;
+      }
+      return recovery_seen;
+    };
+    // As above: the recovery event may reach the host a moment after the health.
+    CHECK(wait_host([&](const InstanceInfo& i) { return std::string(health_of(i)) == "ok" && scan_events(); }));
     CHECK(host.devices_in_fault() == 0);
     CHECK(host.device_fault_count() == 1);
-    bool fault_seen = false, recovery_seen = false;
-    for (const HostEvent& e : host.events()) {
-      fault_seen |= e.type == HostEvent::Type::device_fault && e.instance == instance_;
-      recovery_seen |= e.type == HostEvent::Type::device_recovered && e.instance == instance_ && fault_seen;
-    }
     CHECK(fault_seen);
     CHECK(recovery_seen);
   }
