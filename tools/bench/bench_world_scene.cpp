@@ -16,23 +16,11 @@ namespace {
 
 using Vec3 = sheet::Vec3;
 using robot::Side;
-using world::Pose;
 using world::SideKinematics;
 
 double deg(double d) { return d * std::numbers::pi / 180.0; }
 
 using namespace crease::world::poses;
-
-KDL::Rotation frame_from_z_x(KDL::Vector z, KDL::Vector x) {
-  z.Normalize();
-  x = x - KDL::dot(x, z) * z;
-  x.Normalize();
-  return KDL::Rotation(x, z * x, z);
-}
-KDL::Frame to_frame(const Pose& p) {
-  return KDL::Frame(KDL::Rotation(p.r[0], p.r[1], p.r[2], p.r[3], p.r[4], p.r[5], p.r[6], p.r[7], p.r[8]),
-                    KDL::Vector(p.t.x, p.t.y, p.t.z) / 1000.0);
-}
 
 // A side's tool path: the index pad's point (mm) and the hand's angles at every step.
 struct Path {
@@ -68,7 +56,7 @@ bool solve_arm(const robot::RobotModel& model, Side side, const Path& path, cons
   SideKinematics kin(model, side);
   kin.update_rt(q, path.hand.front());
   const std::string prefix = model.params().side(side).prefix;
-  const KDL::Frame world_palm = to_frame(kin.link_pose(kin.link_index(prefix + "palm")));
+  const KDL::Frame world_palm = to_kdl_frame(kin.link_pose(kin.link_index(prefix + "palm")));
   ik.set_tool(robot::ToolFrame::ff_pad, q, path.hand.front());
   const KDL::Frame palm_pad = world_palm.Inverse() * ik.tool_pose(q);
   arm.resize(path.pad.size());
@@ -85,8 +73,6 @@ bool solve_arm(const robot::RobotModel& model, Side side, const Path& path, cons
   }
   return true;
 }
-
-KDL::Rotation palm_forward_down(double beta) { return frame_from_z_x({0, std::cos(beta), -std::sin(beta)}, {-1, 0, 0}); }
 
 bool finish(const robot::RobotModel& model, const std::array<Path, 2>& paths, const std::array<KDL::Rotation, 2>& palm,
             Script& out) {
@@ -138,16 +124,7 @@ bool pinch_script(const robot::RobotModel& model, Script& out) {
   out.params.initial_stiffness_nm_per_rad = 1.0;
   for (HandQ& k : out.stiffness) k.fill(1.0);
   const double dt = out.params.dt_s;
-  // The right palm hanging down, turned so that the thumb pad faces straight down onto the index.
-  const HandQ closed = pinch_hand(0.696);
-  const KDL::Rotation r0 = frame_from_z_x({0, 0, -1}, {1, 0, 0});
-  SideKinematics k(model, Side::right);
-  k.update_rt(ArmQ{}, closed);
-  const KDL::Frame palm = to_frame(k.link_pose(k.link_index("r_palm")));
-  const KDL::Frame th = to_frame(k.link_pose(k.link_index("r_thpad")));
-  const KDL::Vector n = r0 * (palm.M.Inverse() * th.M.UnitZ()), down(0, 0, -1);
-  const KDL::Vector axis = n * down;
-  const KDL::Rotation right_palm = KDL::Rotation::Rot2(axis / axis.Norm(), std::atan2(axis.Norm(), KDL::dot(n, down))) * r0;
+  const KDL::Rotation right_palm = pinch_palm(model, pinch_hand(0.696));  // thumb pad straight down
 
   const Vec3 at{87, -134, -8};  // under the corner, 48.5 mm over the near edge
   std::array<Path, 2> p{Path{{at}, {pinch_hand(0.3)}}, Path{{{-40, 60, 8}}, {index_out()}}};

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "plugins/robot_model/robot_model.h"
+#include "plugins/sim_world/reference_poses.h"
 #include "plugins/sim_world/sim_world.h"
 
 namespace scene {
@@ -34,18 +35,12 @@ inline const robot::RobotModel& robot_model() {
 
 inline double deg(double d) { return d * std::numbers::pi / 180.0; }
 
-// Hand joint indices (drivers/README.md §3).
-enum HandJoint { WRJ2, WRJ1, FFJ4, FFJ3, FFJ2, MFJ4, MFJ3, MFJ2, RFJ4, RFJ3, RFJ2, LFJ5, LFJ4, LFJ3, LFJ2,
-                 THJ5, THJ4, THJ3, THJ2, THJ1 };
+// Hand joint indices (drivers/README.md §3), index_out(), pinch_hand(): reference_poses.h.
+using namespace poses::joints;
 
-// A rotation from its z axis (unit) and a vector near its x axis.
+// A rotation from its z axis and a vector near its x axis (plugins/sim_world/reference_poses.h).
 inline KDL::Rotation frame_from_z_x(Vec3 z, Vec3 x_hint) {
-  const KDL::Vector zz = KDL::Vector(z.x, z.y, z.z) / std::sqrt(z.x * z.x + z.y * z.y + z.z * z.z);
-  KDL::Vector xx(x_hint.x, x_hint.y, x_hint.z);
-  xx = xx - KDL::dot(xx, zz) * zz;
-  xx.Normalize();
-  const KDL::Vector yy = zz * xx;
-  return KDL::Rotation(xx, yy, zz);
+  return poses::frame_from_z_x(KDL::Vector(z.x, z.y, z.z), KDL::Vector(x_hint.x, x_hint.y, x_hint.z));
 }
 
 // Places a tool link of one side's hand at a pose by moving the arm only.
@@ -74,9 +69,9 @@ class ArmIk {
     const int t = kin_->link_index(prefix_ + tool), pl = kin_->link_index(prefix_ + "palm");
     REQUIRE(t >= 0);
     kin_->update_rt(guess, hand);
-    const KDL::Frame world_palm = to_frame(kin_->link_pose(pl));
-    const KDL::Frame palm_tool = world_palm.Inverse() * to_frame(kin_->link_pose(t));
-    const KDL::Frame palm_flange = world_palm.Inverse() * to_frame(kin_->link_pose(flange_));
+    const KDL::Frame world_palm = poses::to_kdl_frame(kin_->link_pose(pl));
+    const KDL::Frame palm_tool = world_palm.Inverse() * poses::to_kdl_frame(kin_->link_pose(t));
+    const KDL::Frame palm_flange = world_palm.Inverse() * poses::to_kdl_frame(kin_->link_pose(flange_));
     const KDL::Vector p = KDL::Vector(p_mm.x, p_mm.y, p_mm.z) / 1000.0 - palm * palm_tool.p;
     const KDL::Frame goal = KDL::Frame(palm, p) * palm_flange;
     KDL::JntArray q0(robot::kArmJoints), q(robot::kArmJoints);
@@ -97,10 +92,6 @@ class ArmIk {
   }
 
  private:
-  static KDL::Frame to_frame(const Pose& p) {
-    return KDL::Frame(KDL::Rotation(p.r[0], p.r[1], p.r[2], p.r[3], p.r[4], p.r[5], p.r[6], p.r[7], p.r[8]),
-                      KDL::Vector(p.t.x, p.t.y, p.t.z) / 1000.0);
-  }
   robot::Side side_;
   KDL::Chain chain_;
   std::unique_ptr<KDL::ChainIkSolverPos_LMA> solver_;
@@ -115,17 +106,10 @@ class ArmIk {
 inline ArmQ arm_guess() { return {0.0, 0.5, 0.0, 1.4, 0.0, 1.2, 0.0}; }
 
 // Only the index finger out: the others bent back to their J3 limit (-15 deg).
-inline HandQ index_out() {
-  HandQ h{};
-  h[MFJ3] = h[RFJ3] = h[LFJ3] = deg(-15);
-  return h;
-}
+using poses::index_out;
 
-// The palm turned forward (+y) and down by BETA, its palmar face down and forward (either
-// hand: the left mirrors the right in its palm's x, so its thumb comes out on the other side).
-inline KDL::Rotation palm_forward_down(robot::Side, double beta) {
-  return frame_from_z_x({0, std::cos(beta), -std::sin(beta)}, {-1.0, 0, 0});
-}
+// The palm turned forward (+y) and down by BETA (either hand: reference_poses.h).
+inline KDL::Rotation palm_forward_down(robot::Side, double beta) { return poses::palm_forward_down(beta); }
 
 // A world with the working hand's tool TOOL at START (palm turned PALM, hand HAND) and the
 // other hand parked high beside the table; the nominal world unless PARAMS says otherwise.

@@ -16,19 +16,8 @@ namespace {
 // The pinch (plugins/sim_world/reference_poses.h): THJ5 0.3 open, 0.696 pads 4 mm apart.
 using crease::world::poses::pinch_hand;
 
-// The palm hanging down, turned so that the thumb pad faces straight down onto the index pad.
-KDL::Rotation pinch_palm(const HandQ& h) {
-  const KDL::Rotation r0 = frame_from_z_x({0, 0, -1}, {1, 0, 0});
-  SideKinematics k(robot_model(), robot::Side::right);
-  k.update_rt(ArmQ{}, h);
-  const Pose& palm = k.link_pose(k.link_index("r_palm"));
-  const Pose& th = k.link_pose(k.link_index("r_thpad"));
-  const KDL::Rotation rp(palm.r[0], palm.r[1], palm.r[2], palm.r[3], palm.r[4], palm.r[5], palm.r[6], palm.r[7],
-                         palm.r[8]);
-  const KDL::Vector n = r0 * (rp.Inverse() * KDL::Vector(th.r[2], th.r[5], th.r[8])), down(0, 0, -1);
-  const KDL::Vector axis = n * down;
-  return KDL::Rotation::Rot2(axis / axis.Norm(), std::atan2(axis.Norm(), KDL::dot(n, down))) * r0;
-}
+// The palm hanging down, the thumb pad facing straight down onto the index pad (reference_poses.h).
+KDL::Rotation pinch_palm(const HandQ& h) { return crease::world::poses::pinch_palm(robot_model(), h); }
 
 struct Pinch {
   double force_n = 0;  // squeeze between the pads once closed
