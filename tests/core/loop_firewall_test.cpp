@@ -71,6 +71,11 @@ struct Fixture {
     REQUIRE(wait_for([&] { return loop().timing().cycles.load() >= c0 + n; }, 60s));
     return {loop().timing().cycles.load() - c0, loop().timing().overruns.load() - o0};
   }
+  // The loop stores an instance's state a moment before it queues the fault event that the
+  // host takes on poll(): wait for both before checking either.
+  bool faulted_and_reported(const std::string& name) {
+    return info(name).state == crease::RunState::faulted && !fault_detail(name).empty();
+  }
   std::string fault_detail(const std::string& name) {
     for (const auto& e : seen) {
       if (e.type == crease::HostEvent::Type::fault && e.instance == name) return e.detail;
@@ -87,7 +92,7 @@ TEST_CASE_FIXTURE(Fixture, "a 1500 us plugin in a 1 kHz loop is stopped after N 
   CHECK(info("heavy").limits.budget_ns == 1'000'000);
   CHECK(info("heavy").limits.budget_cycles == crease::FirewallLimits::kDefaultBudgetCycles);
   host.start();
-  REQUIRE(wait_for([&] { return info("heavy").state == crease::RunState::faulted; }));
+  REQUIRE(wait_for([&] { return faulted_and_reported("heavy"); }));
   const crease::InstanceInfo heavy = info("heavy");
   CHECK(heavy.last_fault == crease::FaultKind::over_budget);
   CHECK(heavy.stats->over_budget.load() >= crease::FirewallLimits::kDefaultBudgetCycles);
@@ -125,7 +130,7 @@ TEST_CASE_FIXTURE(Fixture, "a configured budget and cycle count apply; a cycle w
   light.budget_cycles = 50;
   host.add_instance(light);
   host.start();
-  REQUIRE(wait_for([&] { return info("light").state == crease::RunState::faulted; }));
+  REQUIRE(wait_for([&] { return faulted_and_reported("light"); }));
   CHECK(info("light").stats->updates.load() >= 50);
   CHECK(info("light").stats->over_budget.load() >= 50);
   CHECK(fault_detail("light").find("(100 us) for 50 consecutive cycles") != std::string::npos);
@@ -189,7 +194,7 @@ TEST_CASE_FIXTURE(Fixture, "with deactivate_on_allocation an allocating plugin i
   noop.deactivate_on_allocation = true;
   host.add_instance(noop);
   host.start();
-  REQUIRE(wait_for([&] { return info("alloc").state == crease::RunState::faulted; }));
+  REQUIRE(wait_for([&] { return faulted_and_reported("alloc"); }));
   CHECK(info("alloc").last_fault == crease::FaultKind::rt_allocation);
   CHECK(info("alloc").stats->updates.load() == 6);  // stopped in the cycle of its first allocation
   CHECK(info("alloc").stats->rt_allocations.load() == 1);
