@@ -1,6 +1,5 @@
 #include "core/loop.h"
 
-#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <thread>
@@ -147,7 +146,18 @@ void Loop::finish_instance_rt(PluginInstance& inst, std::int64_t ns, Status stat
   } else if (status != Status::device_fault && before == Status::device_fault) {
     push_event_rt(make_event(LoopEvent::Type::device_recovered, FaultKind::none, 0, cycle, t0, inst));
   }
-  if (inst.over_budget_rt(ns)) {
+  // Over budget by the wall clock: charge only what the hook ran, not the time the thread was
+  // preempted (a loaded machine's doing, not the plugin's), unless it blocked. Sampling the
+  // thread's CPU clock costs about 1 us, so the loop samples only in the cycles after one that ran
+  // over by the wall clock; such a first cycle is left uncounted (neither over nor within).
+  const std::int64_t budget = inst.limits().budget_ns;
+  std::int64_t charged = ns;
+  if (budget > 0 && ns > budget && discount_preemption_.load(std::memory_order_relaxed)) {
+    sample_next_cycle_ = true;
+    if (!have_cycle_cpu_) return;
+    charged = rt::charged_hook_ns(ns, cycle_cpu_, rt::sample_thread_cpu());
+  }
+  if (inst.over_budget_rt(charged)) {
     trip_rt(inst, FaultKind::over_budget, static_cast<std::int32_t>(inst.limits().budget_cycles), cycle, t0 + ns);
   }
 }
@@ -157,6 +167,9 @@ void Loop::run_cycle_rt(const rt::CycleClock& clock) noexcept {
   const Schedule* s = current_.load(std::memory_order_relaxed);  // only this thread stores it while running
   const crease_cycle cycle{clock.cycle, clock.deadline_ns, clock.period_ns, clock.wake_ns};
   const std::uint64_t* allocs = count_allocations_.load(std::memory_order_relaxed) ? rt::this_thread_rt_allocations() : nullptr;
+  have_cycle_cpu_ = sample_next_cycle_;
+  sample_next_cycle_ = false;
+  if (have_cycle_cpu_) cycle_cpu_ = rt::sample_thread_cpu();
   bool any_write = false;
   // Phase 1: update, in run order.
   for (const Schedule::Entry& e : s->entries) {

@@ -17,7 +17,10 @@
 // writes a non-finite output stops that instance (outputs driven safe, state faulted) and is
 // reported as an event; the loop keeps its timing and runs the others. So is an instance whose
 // update + write ran longer than its time budget (FirewallLimits) for budget_cycles cycles in
-// a row, measured with the two clock reads per hook the loop makes anyway, and, when its
+// a row, measured with the two clock reads per hook the loop makes anyway, less the time the loop
+// thread was preempted (rt::charged_hook_ns; blocking is charged in full). The thread's CPU clock
+// is sampled only in the cycles after one that ran over by the wall clock, so such a run's first
+// cycle is not counted, and budget_cycles + 1 cycles over it stop an instance. And, when its
 // limits say so, one that allocated on the heap in a hook. Allocations are counted per
 // instance (PluginStats::rt_allocations) from the loop thread's own counter
 // (rt::this_thread_rt_allocations: one load before and one after each hook) while
@@ -35,6 +38,7 @@
 #include "core/plugin_instance.h"
 #include "rt/log_queue.h"
 #include "rt/periodic_loop.h"
+#include "rt/thread_cpu.h"
 #include "rt/queue.h"
 
 namespace crease {
@@ -118,6 +122,10 @@ class Loop {
   void set_count_allocations(bool on) noexcept { count_allocations_.store(on, std::memory_order_relaxed); }
   [[nodiscard]] bool count_allocations() const noexcept { return count_allocations_.load(std::memory_order_relaxed); }
 
+  // Whether the time budget leaves out the time the loop thread was preempted (default on; off
+  // only to show what wall-time budgets do on a loaded machine). Any thread.
+  void set_discount_preemption(bool on) noexcept { discount_preemption_.store(on, std::memory_order_relaxed); }
+
   // Runs one cycle on the calling thread (tests and benchmarks of the cycle itself).
   void run_cycle_rt(const rt::CycleClock& clock) noexcept;
 
@@ -145,6 +153,10 @@ class Loop {
   std::uint64_t published_ = 0;               // non-RT: generation of the last publication
   std::unique_ptr<unsigned char[]> state_buf_;
   std::atomic<bool> count_allocations_{true};
+  std::atomic<bool> discount_preemption_{true};
+  rt::ThreadCpuSample cycle_cpu_;   // loop thread: sampled at the cycle's start (budget checks)
+  bool have_cycle_cpu_ = false;     // loop thread: cycle_cpu_ is this cycle's
+  bool sample_next_cycle_ = false;  // loop thread: a hook ran over its budget by the wall clock
   rt::QueueChannel events_;
   rt::RtLogQueue log_;
   rt::PeriodicLoop thread_;  // last: its thread stops before the members above go

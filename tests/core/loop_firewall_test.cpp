@@ -6,12 +6,19 @@
 
 #include <doctest/doctest.h>
 
+#include <sched.h>
+#include <sys/resource.h>
+
+#include <atomic>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "core/plugin_host.h"
 #include "plugins/test_plugins/test_ports.h"
 #include "rt/alloc_guard.h"
+#include "support/host_poll.h"
 
 using crease::test_plugins::TestValue;
 using namespace std::chrono_literals;
@@ -43,13 +50,7 @@ struct Fixture {
   // Waits until `pred` holds, polling the host so events are drained; at most `limit`.
   template <class P>
   bool wait_for(P pred, std::chrono::milliseconds limit = 10s) {
-    const auto until = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < until) {
-      host.poll();
-      if (pred()) return true;
-      std::this_thread::sleep_for(1ms);
-    }
-    return false;
+    return crease::testing::poll_until(host, pred, limit);
   }
   crease::InstanceInfo info(const std::string& name) {
     for (const auto& i : host.instances()) {
@@ -139,6 +140,91 @@ TEST_CASE_FIXTURE(Fixture, "a configured budget and cycle count apply; a cycle w
   host.activate("light");
   REQUIRE(wait_for([&] { return host.fault_count() == 2; }));
   CHECK(info("light").stats->updates.load() >= updates + 50);
+  host.stop();
+}
+
+namespace {
+// Sets the nice value of this process's thread named `comm` (Linux: nice is per thread). A loop
+// thread at nice 19 beside a spinning thread at nice 0 on the same CPU gets about 1.5 % of it:
+// the scheduler preempts it in most hooks, as a loaded machine does.
+bool renice_thread(const std::string& comm, int nice) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream in(task.path() / "comm");
+    std::string name;
+    std::getline(in, name);
+    if (name != comm) continue;
+    const auto tid = static_cast<id_t>(std::stoi(task.path().filename().string()));
+    return setpriority(PRIO_PROCESS, tid, nice) == 0;
+  }
+  return false;
+}
+
+// A thread spinning on one CPU until destroyed.
+struct Hog {
+  std::atomic<bool> stop{false};
+  std::thread thread;
+  explicit Hog(int cpu) {
+    thread = std::thread([this, cpu] {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      CPU_SET(cpu, &set);
+      sched_setaffinity(0, sizeof set, &set);
+      while (!stop.load(std::memory_order_relaxed)) {
+      }
+    });
+  }
+  ~Hog() {
+    stop = true;
+    thread.join();
+  }
+};
+
+// A 100 Hz loop pinned to CPU 0 and starved there by a Hog: a 6 ms plugin with a 10 ms budget,
+// stopped at its first cycle over it, whose hooks run long by the wall clock only because the
+// thread is preempted (a hook longer than a scheduler tick is preempted at the tick).
+struct Starved : Fixture {
+  crease::Loop& pinned = host.add_loop({"starved", 100.0, 0, 0});
+  void run(bool discount) {
+    pinned.set_discount_preemption(discount);
+    crease::InstanceSpec s = spec("busy", "crease_test_slow", 0, "{busy_us: 6000, after: 0}");
+    s.loop = "starved";
+    s.budget_ns = 10'000'000;
+    s.budget_cycles = 1;
+    host.add_instance(s);
+    host.start();
+    REQUIRE(wait_for([&] { return renice_thread("crease-starved", 19); }));
+  }
+};
+}  // namespace
+
+TEST_CASE_FIXTURE(Starved, "a plugin preempted by a busier thread is not charged the time it was off the CPU") {
+  Hog hog(0);
+  run(true);
+  REQUIRE(wait_for([&] {
+    const crease::InstanceInfo i = info("busy");
+    return i.state != crease::RunState::active || (i.stats->updates.load() >= 10 && i.stats->execution.max_ns() > 10'000'000);
+  }, 60s));
+  const crease::InstanceInfo busy = info("busy");
+  CHECK(busy.stats->execution.max_ns() > 10'000'000);  // by the wall clock a hook ran over the budget
+  CHECK(busy.stats->over_budget.load() == 0);       // but it was never charged for it
+  CHECK(busy.state == crease::RunState::active);
+  host.stop();
+}
+
+TEST_CASE_FIXTURE(Starved, "failing variant: with preemption charged the same plugin is stopped") {
+  Hog hog(0);
+  run(false);
+  REQUIRE(wait_for([&] { return faulted_and_reported("busy"); }, 60s));
+  CHECK(info("busy").last_fault == crease::FaultKind::over_budget);
+  host.stop();
+}
+
+TEST_CASE_FIXTURE(Fixture, "a plugin that blocks is charged the time it slept: stopped after N cycles") {
+  host.add_instance(spec("sleeper", "crease_test_slow", 0, "{busy_us: 0, sleep_us: 1500, after: 0}"));
+  host.start();
+  REQUIRE(wait_for([&] { return faulted_and_reported("sleeper"); }));
+  CHECK(info("sleeper").last_fault == crease::FaultKind::over_budget);
+  CHECK(fault_detail("sleeper").find("ran over its time budget (1000 us) for 20 consecutive cycles") != std::string::npos);
   host.stop();
 }
 

@@ -8,6 +8,7 @@
 #include "core/errors.h"
 #include "plugins/test_plugins/test_ports.h"
 #include "rt/alloc_guard.h"
+#include "support/host_poll.h"
 
 using crease::test_plugins::TestValue;
 using namespace std::chrono_literals;
@@ -38,12 +39,7 @@ struct Fixture {
   // Waits until `pred` holds (polling the host so events are processed), at most 3 s.
   template <class P>
   bool wait_for(P pred) {
-    for (int i = 0; i < 3000; ++i) {
-      host.poll();
-      if (pred()) return true;
-      std::this_thread::sleep_for(1ms);
-    }
-    return false;
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(3));
   }
   crease::RunState state(const std::string& name) {
     for (const auto& i : host.instances()) {

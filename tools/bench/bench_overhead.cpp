@@ -3,7 +3,9 @@
 // 10 no-op calls made through plain virtual functions in the same run; then what counting the
 // plugins' heap allocations adds (the loop reads its thread's allocation counter before and
 // after each hook), with and without it in interleaved turns so a neighbour's load falls on
-// both alike, and what the counting operator new adds to one allocation off the RT threads.
+// both alike, the same for the time budget's per-cycle sample of the thread's CPU clock (which
+// keeps preemption out of a plugin's charge), and what the counting operator new adds to one
+// allocation off the RT threads.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,6 +18,7 @@
 #include "core/plugin_host.h"
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
+#include "rt/thread_cpu.h"
 
 namespace {
 struct Base {
@@ -60,6 +63,39 @@ void allocation_hook_cost(std::uint64_t n) {
   std::printf("overhead_alloc_hook: hooked_ns=%.1f malloc_ns=%.1f hook_ns=%.1f\n", h, m, h - m);
 }
 
+constexpr int kTurns = 40;
+
+struct Paired {
+  double on = 0, off = 0, diff = 0;  // medians: ns per cycle with the setting on, off, and of the pairs' differences
+};
+
+// Runs the loop's cycles in kTurns pairs, one half of each pair with `set(true)` and one with
+// `set(false)`, alternating which goes first.
+template <class Set>
+Paired paired_turns(crease::Loop& loop, crease::rt::CycleClock& clock, std::uint64_t cycles, Set set) {
+  std::vector<double> on_ns, off_ns, diff_ns;
+  for (int turn = 0; turn < kTurns; ++turn) {
+    double pair[2] = {0, 0};
+    for (const bool on : {turn % 2 == 0, turn % 2 != 0}) {
+      set(on);
+      const auto a = std::chrono::steady_clock::now();
+      for (std::uint64_t i = 0; i < cycles / kTurns; ++i) {
+        ++clock.cycle;
+        loop.run_cycle_rt(clock);
+      }
+      pair[on ? 0 : 1] = ns_per(std::chrono::steady_clock::now() - a, cycles / kTurns);
+    }
+    on_ns.push_back(pair[0]);
+    off_ns.push_back(pair[1]);
+    diff_ns.push_back(pair[0] - pair[1]);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  return {median(on_ns), median(off_ns), median(diff_ns)};
+}
+
 int run(int argc, char** argv) {
   const auto cycles = static_cast<std::uint64_t>(crease::bench::arg_double(argc, argv, "--cycles", 2e6));
   crease::PluginHost host({CREASE_PLUGIN_DIR});
@@ -96,39 +132,33 @@ int run(int argc, char** argv) {
   std::printf("overhead: ours_ns_per_cycle=%.1f plain_ns_per_cycle=%.1f framework_ns=%.1f plugins=10\n", ours_ns,
               plain_ns, ours_ns - plain_ns);
 
-  // Allocation counting on and off, in 40 paired turns, on an RT-marked thread (as a loop's):
-  // the median of the pairs' differences, so a neighbour's burst spoils a few pairs, not the figure.
+  // Allocation counting, and the time budget's CPU-clock sample, each on and off in 40 paired
+  // turns on an RT-marked thread (as a loop's): the median of the pairs' differences, so a
+  // neighbour's burst spoils a few pairs, not the figure.
   {
     const crease::rt::ScopedRtMark rt_mark;
-    constexpr int kTurns = 40;
-    std::vector<double> on_ns, off_ns, diff_ns;
-    std::uint64_t c = 0;
-    for (int turn = 0; turn < kTurns; ++turn) {
-      double pair[2] = {0, 0};
-      for (const bool counting : {turn % 2 == 0, turn % 2 != 0}) {  // alternate which goes first
-        loop.set_count_allocations(counting);
-        const auto a = std::chrono::steady_clock::now();
-        for (std::uint64_t i = 0; i < cycles / kTurns; ++i) {
-          clock.cycle = c++;
-          loop.run_cycle_rt(clock);
-        }
-        pair[counting ? 0 : 1] = ns_per(std::chrono::steady_clock::now() - a, cycles / kTurns);
-      }
-      on_ns.push_back(pair[0]);
-      off_ns.push_back(pair[1]);
-      diff_ns.push_back(pair[0] - pair[1]);
-    }
+    const Paired counting = paired_turns(loop, clock, cycles, [&](bool on) { loop.set_count_allocations(on); });
     loop.set_count_allocations(true);
-    auto median = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      return v[v.size() / 2];
-    };
-    const double on = median(on_ns), off = median(off_ns), d = median(diff_ns);
     std::printf("  allocation counting on: %8.1f ns per cycle; off: %8.1f ns per cycle (medians of %d turns); "
                 "counting: %+.1f ns per cycle (median of the pairs' differences, %+.2f ns per plugin)\n",
-                on, off, kTurns, d, d / 10.0);
-    std::printf("overhead_alloc_count: on_ns_per_cycle=%.1f off_ns_per_cycle=%.1f counting_ns=%.1f plugins=10\n", on, off,
-                d);
+                counting.on, counting.off, kTurns, counting.diff, counting.diff / 10.0);
+    std::printf("overhead_alloc_count: on_ns_per_cycle=%.1f off_ns_per_cycle=%.1f counting_ns=%.1f plugins=10\n",
+                counting.on, counting.off, counting.diff);
+    const Paired sampling = paired_turns(loop, clock, cycles, [&](bool on) { loop.set_discount_preemption(on); });
+    loop.set_discount_preemption(true);
+    // What one sample costs: the loop takes two per cycle only after a cycle over budget.
+    constexpr int kSamples = 100'000;
+    std::int64_t sink_ns = 0;
+    const auto s0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < kSamples; ++i) sink_ns += crease::rt::sample_thread_cpu().cpu_ns & 1;
+    const double sample_ns = ns_per(std::chrono::steady_clock::now() - s0, kSamples);
+    std::printf("  time budget's preemption discount on: %8.1f ns per cycle; off: %8.1f ns per cycle; difference: "
+                "%+.1f ns per cycle with no plugin over budget; one CPU-clock sample (taken only after a cycle over "
+                "budget): %.1f ns%s\n",
+                sampling.on, sampling.off, sampling.diff, sample_ns, sink_ns < 0 ? "" : "");
+    std::printf("overhead_budget_clock: on_ns_per_cycle=%.1f off_ns_per_cycle=%.1f discount_ns=%.1f sample_ns=%.1f "
+                "plugins=10\n",
+                sampling.on, sampling.off, sampling.diff, sample_ns);
   }
   allocation_hook_cost(cycles * 5);
   return 0;

@@ -15,6 +15,7 @@
 #include "core/plugin_host.h"
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
+#include "support/host_poll.h"
 
 using namespace std::chrono_literals;
 
@@ -56,12 +57,7 @@ struct Fixture {
   }
   template <class P>
   bool wait_for(P pred) {
-    for (int i = 0; i < 2000; ++i) {
-      host.poll();
-      if (pred()) return true;
-      std::this_thread::sleep_for(5ms);
-    }
-    return false;
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(10), std::chrono::milliseconds(5));
   }
   // Mean world x of the key-points of one vision frame with some, mm.
   double mean_x() {

@@ -16,6 +16,7 @@
 #include "core/port_types/camera_frames.h"
 #include "plugins/camera_rig/camera_model.h"
 #include "support/opencv_threads.h"
+#include "support/host_poll.h"
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
@@ -57,12 +58,7 @@ struct Loop {
   }
   template <class P>
   bool wait_for(P pred) {
-    for (int i = 0; i < 2000; ++i) {  // at most ~10 s
-      host.poll();
-      if (pred()) return true;
-      std::this_thread::sleep_for(5ms);
-    }
-    return false;
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(10), std::chrono::milliseconds(5));
   }
   // Waits for `cycles` more updates; true when none of them was degraded.
   bool ok_for(std::uint64_t cycles) {

@@ -12,6 +12,7 @@
 #include "plugins/sheet_model/synthetic_markers.h"
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
+#include "support/host_poll.h"
 
 using namespace std::chrono_literals;
 
@@ -37,12 +38,7 @@ struct Fixture {
   }
   template <class P>
   bool wait_for(P pred) {
-    for (int i = 0; i < 5000; ++i) {
-      host.poll();
-      if (pred()) return true;
-      std::this_thread::sleep_for(1ms);
-    }
-    return false;
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(5));
   }
 };
 

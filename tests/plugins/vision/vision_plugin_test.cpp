@@ -19,6 +19,7 @@
 #include "plugins/cameras/replay_source.h"
 #include "plugins/sim_world/scene/sim_source.h"
 #include "rt/alloc_guard.h"
+#include "support/host_poll.h"
 
 using namespace std::chrono_literals;
 using namespace crease::vision;
@@ -109,12 +110,7 @@ struct Fixture {
   }
   template <class P>
   bool wait_for(P pred) {
-    for (int i = 0; i < 2000; ++i) {
-      host.poll();
-      if (pred()) return true;
-      std::this_thread::sleep_for(5ms);
-    }
-    return false;
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(10), std::chrono::milliseconds(5));
   }
 };
 
