@@ -33,6 +33,15 @@ std::vector<FigureReading> FigureWatch::take() {
   return now;
 }
 
+std::vector<report::FigureSummary> figure_summaries(const PortRegistry& ports) {
+  std::vector<report::FigureSummary> out;
+  for (const FigureReading& r : FigureWatch(ports).take()) {
+    out.push_back({r.port, r.figure.label, r.figure.unit, r.figure.sample, r.figure.count, r.figure.mean(),
+                   r.figure.last, r.figure.max});
+  }
+  return out;
+}
+
 std::string progress_text(const std::vector<FigureReading>& figures) {
   std::string out;
   for (const FigureReading& r : figures) {

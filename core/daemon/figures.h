@@ -9,6 +9,7 @@
 
 #include "core/port_registry.h"
 #include "core/port_types/figure.h"
+#include "core/report/timing_report.h"
 
 namespace crease::daemon {
 
@@ -30,6 +31,9 @@ class FigureWatch {
   const PortRegistry& ports_;
   std::vector<FigureReading> last_;
 };
+
+// Every figure now (by port name), as the report and `creasectl stats` show it.
+[[nodiscard]] std::vector<report::FigureSummary> figure_summaries(const PortRegistry& ports);
 
 // "; LABEL: X UNIT (this second), Y UNIT (mean so far)" for each figure with samples.
 [[nodiscard]] std::string progress_text(const std::vector<FigureReading>& figures);

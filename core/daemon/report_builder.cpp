@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/daemon/figures.h"
 #include "core/report/from_rt.h"
 #include "core/report/render.h"
 #include "rt/clock.h"
@@ -103,6 +104,7 @@ report::TimingReport build_report(const PluginHost& host, const RunFacts& facts)
   for (const HostEvent& e : host.events()) {
     r.events.push_back({e.time_ns, event_kind(e.type), e.loop, e.instance, e.detail});
   }
+  r.figures = figure_summaries(host.ports());
   return r;
 }
 

@@ -1,4 +1,5 @@
 #include "core/daemon/views.h"
+#include "core/daemon/figures.h"
 #include "core/daemon/sequences.h"
 #include "core/report/report_json.h"
 #include "rt/alloc_guard.h"
@@ -132,6 +133,7 @@ nlohmann::json stats_view(const PluginHost& host, const control::ControlServer* 
           {"device_faults", host.device_fault_count()},
           {"rt_allocations", {{"counted", rt::alloc_hooks_installed()}, {"total", allocations}}},
           {"plugins", plugins},
+          {"figures", figure_summaries(host.ports())},
           {"loops", loops_view(host)}};
 }
 

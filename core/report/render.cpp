@@ -188,6 +188,11 @@ std::string render_text(const TimingReport& r) {
     }
     out += '\n';
   }
+  out += "# Figures\n";
+  for (const FigureSummary& f : r.figures) {
+    appendf(out, "#   %s (%s): mean %.3f %s over %" PRIu64 " %s, last %.3f, worst %.3f\n", one_line(f.label).c_str(),
+            f.port.c_str(), f.mean, one_line(f.unit).c_str(), f.count, one_line(f.sample).c_str(), f.last, f.max);
+  }
   out += "# Events\n";
   for (const Event& e : r.events) {
     appendf(out, "#   %.6f s %s loop=%s plugin=%s %s\n", (e.time_ns - r.start_ns) * 1e-9,

@@ -265,6 +265,15 @@ std::string render_html(const TimingReport& r) {
   }
   h += "</table>\n";
 
+  h += "<h2>Figures</h2><table><tr><th class=\"l\">figure</th><th class=\"l\">port</th><th>mean</th>"
+       "<th>last</th><th>worst</th><th class=\"l\">unit</th><th>samples</th></tr>";
+  for (const FigureSummary& f : r.figures) {
+    h += "<tr><td class=\"l\">" + esc(f.label) + "</td><td class=\"l\">" + esc(f.port) + "</td><td>" + num(f.mean, 3) +
+         "</td><td>" + num(f.last, 3) + "</td><td>" + num(f.max, 3) + "</td><td class=\"l\">" + esc(f.unit) +
+         "</td><td>" + std::to_string(f.count) + " " + esc(f.sample) + "</td></tr>";
+  }
+  h += "</table>\n";
+
   h += "<h2>Events</h2><table><tr><th>time s</th><th class=\"l\">kind</th><th class=\"l\">loop"
        "</th><th class=\"l\">plugin</th><th class=\"l\">detail</th></tr>";
   for (const Event& e : r.events) {

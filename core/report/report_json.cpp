@@ -68,6 +68,16 @@ void from_json(const nlohmann::json& j, Event& v) {
   CREASE_J_IN(detail)
 }
 
+void to_json(nlohmann::json& j, const FigureSummary& v) {
+  j = nlohmann::json::object();
+  CREASE_J_OUT(port) CREASE_J_OUT(label) CREASE_J_OUT(unit) CREASE_J_OUT(sample) CREASE_J_OUT(count)
+  CREASE_J_OUT(mean) CREASE_J_OUT(last) CREASE_J_OUT(max)
+}
+void from_json(const nlohmann::json& j, FigureSummary& v) {
+  CREASE_J_IN(port) CREASE_J_IN(label) CREASE_J_IN(unit) CREASE_J_IN(sample) CREASE_J_IN(count)
+  CREASE_J_IN(mean) CREASE_J_IN(last) CREASE_J_IN(max)
+}
+
 void to_json(nlohmann::json& j, const PortTraffic& v) {
   j = nlohmann::json::object();
   CREASE_J_OUT(name) CREASE_J_OUT(kind) CREASE_J_OUT(type) CREASE_J_OUT(version)
@@ -104,13 +114,14 @@ void to_json(nlohmann::json& j, const TimingReport& v) {
   j = nlohmann::json::object();
   CREASE_J_OUT(title) CREASE_J_OUT(config_file) CREASE_J_OUT(start_ns) CREASE_J_OUT(end_ns)
   CREASE_J_OUT(wall_clock) CREASE_J_OUT(machine) CREASE_J_OUT(loops) CREASE_J_OUT(ports)
-  CREASE_J_OUT(events)
+  CREASE_J_OUT(events) CREASE_J_OUT(figures)
   j["duration_s"] = v.duration_s();
 }
 void from_json(const nlohmann::json& j, TimingReport& v) {
   CREASE_J_IN(title) CREASE_J_IN(config_file) CREASE_J_IN(start_ns) CREASE_J_IN(end_ns)
   CREASE_J_IN(wall_clock) CREASE_J_IN(machine) CREASE_J_IN(loops) CREASE_J_IN(ports)
   CREASE_J_IN(events)
+  if (j.contains("figures")) CREASE_J_IN(figures)  // reports written before figures had none
 }
 
 }  // namespace crease::report

@@ -20,6 +20,8 @@ void to_json(nlohmann::json& j, const LoopTiming& v);
 void from_json(const nlohmann::json& j, LoopTiming& v);
 void to_json(nlohmann::json& j, const Event& v);
 void from_json(const nlohmann::json& j, Event& v);
+void to_json(nlohmann::json& j, const FigureSummary& v);
+void from_json(const nlohmann::json& j, FigureSummary& v);
 void to_json(nlohmann::json& j, const PortTraffic& v);
 void from_json(const nlohmann::json& j, PortTraffic& v);
 void to_json(nlohmann::json& j, const ThreadPlacement& v);

@@ -120,6 +120,16 @@ struct MachineInfo {
 // left false for the daemon to set.
 [[nodiscard]] MachineInfo probe_machine();
 
+// A figure a plugin reported (a latest port of type crease::Figure: core/port_types/figure.h).
+struct FigureSummary {
+  std::string port;
+  std::string label;   // what is measured, as the plugin names it
+  std::string unit;
+  std::string sample;  // what one sample is
+  std::uint64_t count = 0;
+  double mean = 0, last = 0, max = 0;
+};
+
 struct TimingReport {
   std::string title = "Crease timing report";
   std::string config_file;
@@ -130,6 +140,7 @@ struct TimingReport {
   std::vector<LoopTiming> loops;
   std::vector<PortTraffic> ports;  // by name
   std::vector<Event> events;       // by time
+  std::vector<FigureSummary> figures;  // by port name
 
   [[nodiscard]] double duration_s() const noexcept { return double(end_ns - start_ns) * 1e-9; }
 };

@@ -14,9 +14,13 @@
 //   camera_threads: 0 (default: cameras detected in parallel by OpenCV's pool) or N >= 1 (one
 //            task per camera on the worker and N-1 helper threads of ours, task_team.h; OpenCV's
 //            loops inside each detection still use its pool unless cv::setNumThreads(1))
-// Inputs: images (frames), frames (crease::CameraFrames). Outputs: keypoints (crease::Keypoints).
+// Inputs: images (frames), frames (crease::CameraFrames). Outputs: keypoints (crease::Keypoints),
+// and two figures (crease::Figure, shown in creased's progress, `creasectl stats` and the report):
+// detect_time (ms of detection and triangulation per frame set, on the worker) and
+// keypoints_per_set (key-points triangulated per frame set).
 // Status: degraded when a camera delivered nothing, no new key-points came for
 // `stale_cycles` cycles, or the source ended; fault if the worker failed.
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -24,6 +28,7 @@
 
 #include "core/plugin.h"
 #include "core/port_types/camera_frames.h"
+#include "core/port_types/figure.h"
 #include "core/port_types/keypoints.h"
 #include "plugins/camera_rig/images_port.h"
 #include "plugins/vision/vision_worker.h"
@@ -53,6 +58,10 @@ class VisionPlugin final : public crease::Plugin {
     buf_ = std::make_unique<crease::Keypoints>();
     frames_in_ = ports.latest_input<crease::CameraFrames>("frames");
     out_ = ports.latest_output<crease::Keypoints>("keypoints", crease::Keypoints{});
+    detect_ = named_figure("vision detection per frame set", "ms");
+    per_set_ = named_figure("vision key-points per frame set", "kp");
+    detect_out_ = ports.latest_output<crease::Figure>("detect_time", detect_);
+    per_set_out_ = ports.latest_output<crease::Figure>("keypoints_per_set", per_set_);
     worker_ = std::make_unique<VisionWorker>(std::move(channel), std::move(cams), layout, det, tri,
                                              camera_threads);
   }
@@ -73,6 +82,7 @@ class VisionPlugin final : public crease::Plugin {
       case VisionWorker::Take::fresh:
         out_.write(*buf_, cycle.time_ns);
         since_fresh_ = 0;
+        write_figures(cycle.time_ns);
         return buf_->cameras_ok == worker_->all_cameras_mask() && !source_degraded
                    ? crease::Status::ok
                    : crease::Status::degraded;
@@ -84,6 +94,30 @@ class VisionPlugin final : public crease::Plugin {
         return crease::Status::fault;
     }
     return crease::Status::fault;
+  }
+
+  // RT: the worker's times so far, and the key-points of the set just taken.
+  void write_figures(std::int64_t now_ns) noexcept {
+    const VisionWorker::ProcessTimes t = worker_->process_times();
+    detect_.count = t.count;
+    detect_.sum = static_cast<double>(t.sum_ns) * 1e-6;
+    detect_.last = static_cast<double>(t.last_ns) * 1e-6;
+    detect_.max = static_cast<double>(t.max_ns) * 1e-6;
+    const auto n = static_cast<double>(buf_->count);
+    per_set_.count += 1;
+    per_set_.sum += n;
+    per_set_.last = n;
+    per_set_.max = std::max(per_set_.max, n);
+    detect_out_.write(detect_, now_ns);
+    per_set_out_.write(per_set_, now_ns);
+  }
+
+  static crease::Figure named_figure(const char* label, const char* unit) {
+    crease::Figure f{};
+    std::strncpy(f.label, label, sizeof f.label - 1);
+    std::strncpy(f.unit, unit, sizeof f.unit - 1);
+    std::strncpy(f.sample, "frame sets", sizeof f.sample - 1);
+    return f;
   }
 
   // Non-RT, after a fault too: says why the worker stopped, if it did.
@@ -99,6 +133,8 @@ class VisionPlugin final : public crease::Plugin {
   std::unique_ptr<crease::Keypoints> buf_;
   crease::LatestInput<crease::CameraFrames> frames_in_;
   crease::LatestOutput<crease::Keypoints> out_;
+  crease::Figure detect_{}, per_set_{};  // per_set_ counts the sets taken, detect_ the sets processed
+  crease::LatestOutput<crease::Figure> detect_out_, per_set_out_;
   char channel_name_[crease::CameraFrames::kChannelNameCapacity] = {};
   bool warned_channel_ = false;
   int stale_cycles_ = 10;

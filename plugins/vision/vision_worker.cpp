@@ -1,8 +1,11 @@
 #include "plugins/vision/vision_worker.h"
 
+#include <algorithm>
+
 #include "core/assert.h"
 
 #include "plugins/camera_rig/images_port.h"
+#include "rt/clock.h"
 
 namespace crease::vision {
 
@@ -51,6 +54,15 @@ bool VisionWorker::claim_reader() {
   return true;
 }
 
+VisionWorker::ProcessTimes VisionWorker::process_times() const noexcept {
+  ProcessTimes t;
+  t.count = processed_.load(std::memory_order_acquire);  // the times below are at least this count's
+  t.last_ns = last_ns_.load(std::memory_order_relaxed);
+  t.max_ns = max_ns_.load(std::memory_order_relaxed);
+  t.sum_ns = sum_ns_.load(std::memory_order_relaxed);
+  return t;
+}
+
 void VisionWorker::run() {
   if (!claim_reader()) return;
   try {
@@ -70,7 +82,12 @@ void VisionWorker::run() {
                                              const_cast<std::uint8_t*>(set->pixels(k)))
                                    : cv::Mat();
       }
+      const std::int64_t t0 = crease::rt::now_ns();
       pipeline_.process(images_, set->stamp_ns, *result_);
+      const std::int64_t took = crease::rt::now_ns() - t0;
+      last_ns_.store(took, std::memory_order_relaxed);
+      max_ns_.store(std::max(max_ns_.load(std::memory_order_relaxed), took), std::memory_order_relaxed);
+      sum_ns_.store(sum_ns_.load(std::memory_order_relaxed) + took, std::memory_order_relaxed);
       results_.write(result_.get(), set->stamp_ns);
       processed_.fetch_add(1, std::memory_order_release);
       channel_->finish(set->sequence);  // a source in lockstep may grab the next frame

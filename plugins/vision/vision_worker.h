@@ -44,6 +44,12 @@ class VisionWorker {
   [[nodiscard]] std::uint64_t sets_processed() const noexcept {
     return processed_.load(std::memory_order_acquire);
   }
+  // Detection and triangulation time of the sets processed so far (ns; any thread, RT-safe).
+  struct ProcessTimes {
+    std::uint64_t count = 0;
+    std::int64_t last_ns = 0, max_ns = 0, sum_ns = 0;
+  };
+  [[nodiscard]] ProcessTimes process_times() const noexcept;
   [[nodiscard]] std::string error() const;  // non-RT, valid after `failed`
 
  private:
@@ -61,6 +67,7 @@ class VisionWorker {
   std::atomic<bool> failed_{false};
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> processed_{0};
+  std::atomic<std::int64_t> last_ns_{0}, max_ns_{0}, sum_ns_{0};  // written by the worker only
   std::thread thread_;
 };
 

@@ -3,7 +3,13 @@
 
 #include <doctest/doctest.h>
 
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "core/port.h"
+#include "core/port_types/figure.h"
 #include "core/report/render.h"
+#include "core/report/report_json.h"
 
 TEST_CASE("the report lists the host's ports, a frame channel with its cameras and traffic") {
   crease::PluginHost host({});
@@ -30,4 +36,33 @@ TEST_CASE("the report lists the host's ports, a frame channel with its cameras a
   const std::string text = crease::report::render_text(rep);
   CHECK(text.find("#   port images (frames crease.FrameSet v1, 8 bytes): writer=cameras readers=vision") !=
         std::string::npos);
+}
+
+TEST_CASE("the report and every rendering carry the figures the plugins report; an older report without them reads") {
+  crease::PluginHost host({});
+  auto* ch = host.ports().bind_latest_writer("detect_time", crease::port_type_of<crease::Figure>(), "vision");
+  crease::Figure f{};
+  std::strcpy(f.label, "vision detection per frame set");
+  std::strcpy(f.unit, "ms");
+  std::strcpy(f.sample, "frame sets");
+  f.count = 4;
+  f.sum = 100.0;
+  f.last = 20.0;
+  f.max = 40.0;
+  ch->write(&f, 1);
+  const crease::report::TimingReport rep = crease::daemon::build_report(host, crease::daemon::RunFacts{});
+  REQUIRE(rep.figures.size() == 1);
+  CHECK(rep.figures[0].port == "detect_time");
+  CHECK(rep.figures[0].mean == doctest::Approx(25.0));
+  CHECK(rep.figures[0].max == doctest::Approx(40.0));
+  CHECK(crease::report::render_text(rep).find(
+            "#   vision detection per frame set (detect_time): mean 25.000 ms over 4 frame sets, last 20.000, worst 40.000") !=
+        std::string::npos);
+  CHECK(crease::report::render(rep, crease::report::Format::html).find("<td class=\"l\">vision detection per frame set</td>") !=
+        std::string::npos);
+  nlohmann::json j = nlohmann::json::parse(crease::report::render(rep, crease::report::Format::json));
+  CHECK(j["figures"][0]["label"] == "vision detection per frame set");
+  CHECK(j.get<crease::report::TimingReport>().figures.size() == 1);
+  j.erase("figures");
+  CHECK(j.get<crease::report::TimingReport>().figures.empty());
 }

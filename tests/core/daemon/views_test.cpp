@@ -5,7 +5,11 @@
 #include <doctest/doctest.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
+
+#include "core/port.h"
+#include "core/port_types/figure.h"
 
 namespace {
 struct Sample {
@@ -90,7 +94,23 @@ TEST_CASE("status, loops and stats views of a host") {
   const auto stats = crease::daemon::stats_view(host, nullptr);
   CHECK(stats["control"].is_null());
   CHECK(stats["loops"] == loops);
+  CHECK(stats["figures"].empty());
   CHECK_FALSE(s.contains("control"));
+  // A figure a plugin reports is in stats.
+  auto* fig = host.ports().bind_latest_writer("keypoints_per_set", crease::port_type_of<crease::Figure>(), "vision");
+  crease::Figure f{};
+  std::strcpy(f.label, "vision key-points per frame set");
+  f.count = 2;
+  f.sum = 300;
+  f.last = 160;
+  f.max = 160;
+  fig->write(&f, 1);
+  const auto figures = crease::daemon::stats_view(host, nullptr)["figures"];
+  REQUIRE(figures.size() == 1);
+  CHECK(figures[0]["port"] == "keypoints_per_set");
+  CHECK(figures[0]["label"] == "vision key-points per frame set");
+  CHECK(figures[0]["mean"] == doctest::Approx(150.0));
+  CHECK(figures[0]["last"] == doctest::Approx(160.0));
   // With a server: its clients and refusals, busy replies among them.
   struct Nothing : crease::control::RequestHandler {
     nlohmann::json handle(const nlohmann::json&) override { return {}; }

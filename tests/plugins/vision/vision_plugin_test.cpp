@@ -13,6 +13,7 @@
 #include "core/daemon/views.h"
 #include "core/plugin_host.h"
 #include "core/port_types/camera_frames.h"
+#include "core/port_types/figure.h"
 #include "core/port_types/keypoints.h"
 #include "plugins/camera_rig/marker_sheet.h"
 #include "plugins/cameras/camera_source.h"
@@ -213,6 +214,17 @@ TEST_CASE("camera_sim -> vision with the shipped cameras and layout, recording w
   CHECK(fx.read().timestamp_ns > 0);  // CLOCK_MONOTONIC capture time
   CHECK(fx.frames().sequence >= 3);
   CHECK(fx.frames().valid_mask == 0x1f);
+  // Its figures: the worker's detection time per set and the key-points of the sets taken.
+  crease::Figure detect{}, per_set{};
+  fx.host.ports().find_latest("keypoints_per_set")->read(&per_set, 0);
+  fx.host.ports().find_latest("detect_time")->read(&detect, 0);
+  CHECK(detect.count >= per_set.count);  // every set taken was processed; some processed may not be taken yet
+  CHECK(per_set.count >= 2);
+  CHECK(detect.mean() > 0.0);
+  CHECK(detect.max >= detect.last);
+  CHECK(per_set.last > 100.0);
+  CHECK(per_set.max >= per_set.last);
+  CHECK(per_set.mean() > 100.0);
   fx.host.stop();
   CHECK(fs::exists(rec / "cam0.yaml"));
   CHECK(fs::exists(rec / "cam4" / "000001.png"));
