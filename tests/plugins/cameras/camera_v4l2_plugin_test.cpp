@@ -58,7 +58,7 @@ struct Loop {
   }
   template <class P>
   bool wait_for(P pred) {
-    return crease::testing::poll_until(host, pred, std::chrono::seconds(10), std::chrono::milliseconds(5));
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(30), std::chrono::milliseconds(5));
   }
   // Waits for `cycles` more updates; true when none of them was degraded.
   bool ok_for(std::uint64_t cycles) {

@@ -111,7 +111,7 @@ struct Fixture {
   }
   template <class P>
   bool wait_for(P pred) {
-    return crease::testing::poll_until(host, pred, std::chrono::seconds(10), std::chrono::milliseconds(5));
+    return crease::testing::poll_until(host, pred, std::chrono::seconds(30), std::chrono::milliseconds(5));
   }
 };
 
