@@ -37,10 +37,14 @@ bool dlt_subset(const Camera* cams, const ViewObservation* obs, int n, std::uint
     ++used;
   }
   if (used < 2) return false;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(AtA);
-  const Eigen::Vector4d h = es.eigenvectors().col(0);
-  if (std::abs(h[3]) < 1e-12) return false;
-  X = cv::Vec3d(h[0] / h[3], h[1] / h[3], h[2] / h[3]);
+  // The point minimising |A (X, 1)|: the 3x3 normal equations with the homogeneous coordinate
+  // fixed at 1 (points at a finite distance). About 6 times cheaper than the 4x4 eigenvector,
+  // and the same point up to noise; the Gauss-Newton refinement after it sets the final one.
+  const Eigen::Matrix3d M = AtA.topLeftCorner<3, 3>();
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(M);
+  if (ldlt.info() != Eigen::Success || ldlt.rcond() < 1e-12) return false;
+  const Eigen::Vector3d h = ldlt.solve(-AtA.topRightCorner<3, 1>());
+  X = cv::Vec3d(h[0], h[1], h[2]);
   for (int i = 0; i < n; ++i)
     if ((mask & (1u << i)) && cams[obs[i].camera].to_camera(X)[2] <= 0) return false;
   return std::isfinite(X[0]) && std::isfinite(X[1]) && std::isfinite(X[2]);
