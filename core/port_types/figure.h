@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "core/port_types/payload_layout.h"
 
@@ -21,6 +22,15 @@ struct Figure {
   double sum = 0;           // of every sample (a reader's window mean: change of sum / change of count)
   double last = 0;          // the newest sample
   double max = 0;           // the worst sample
+
+  // A figure with no samples yet, named: each text is cut to fit its field.
+  [[nodiscard]] static Figure named(const char* what, const char* unit_text, const char* sample_text) {
+    Figure f{};
+    std::strncpy(f.label, what, sizeof f.label - 1);
+    std::strncpy(f.unit, unit_text, sizeof f.unit - 1);
+    std::strncpy(f.sample, sample_text, sizeof f.sample - 1);
+    return f;
+  }
 
   [[nodiscard]] bool all_finite() const { return std::isfinite(sum) && std::isfinite(last) && std::isfinite(max); }
   [[nodiscard]] double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }

@@ -15,7 +15,6 @@
 // the first late frame after frames on time is logged (RT log, with the running count), and the
 // totals (frames, late, worst lag, rate achieved) are printed at deactivate.
 #include <cstdio>
-#include <cstring>
 
 #include "core/port_types/figure.h"
 #include "plugins/cameras/camera_plugin.h"
@@ -25,14 +24,6 @@ namespace {
 
 using namespace crease::vision;
 
-crease::Figure named_figure(const char* label, const char* unit) {
-  crease::Figure f{};
-  std::strncpy(f.label, label, sizeof f.label - 1);
-  std::strncpy(f.unit, unit, sizeof f.unit - 1);
-  std::strncpy(f.sample, "frames played", sizeof f.sample - 1);
-  return f;
-}
-
 class CameraReplayPlugin final : public CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
@@ -40,8 +31,8 @@ class CameraReplayPlugin final : public CameraPlugin {
     const int decoders = p.get_in_range<int>("decode_threads", ReplaySource::kDefaultDecoders, 1, 16);
     auto src = std::make_unique<ReplaySource>(p.get_path("replay_dir"), static_cast<std::size_t>(ahead), decoders);
     source_ = src.get();  // owned by the worker, which lives until cleanup()
-    lag_ = named_figure("camera_replay lag behind the recording", "ms");
-    late_ = named_figure("camera_replay frames played late", "%");
+    lag_ = crease::Figure::named("camera_replay lag behind the recording", "ms", "frames played");
+    late_ = crease::Figure::named("camera_replay frames played late", "%", "frames played");
     lag_out_ = ports.latest_output<crease::Figure>("replay_lag", lag_);
     late_out_ = ports.latest_output<crease::Figure>("replay_late", late_);
     seen_played_ = seen_late_ = 0;

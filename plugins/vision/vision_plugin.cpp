@@ -58,8 +58,8 @@ class VisionPlugin final : public crease::Plugin {
     buf_ = std::make_unique<crease::Keypoints>();
     frames_in_ = ports.latest_input<crease::CameraFrames>("frames");
     out_ = ports.latest_output<crease::Keypoints>("keypoints", crease::Keypoints{});
-    detect_ = named_figure("vision detection per frame set", "ms");
-    per_set_ = named_figure("vision key-points per frame set", "kp");
+    detect_ = crease::Figure::named("vision detection per frame set", "ms", "frame sets");
+    per_set_ = crease::Figure::named("vision key-points per frame set", "kp", "frame sets");
     detect_out_ = ports.latest_output<crease::Figure>("detect_time", detect_);
     per_set_out_ = ports.latest_output<crease::Figure>("keypoints_per_set", per_set_);
     worker_ = std::make_unique<VisionWorker>(std::move(channel), std::move(cams), layout, det, tri,
@@ -110,14 +110,6 @@ class VisionPlugin final : public crease::Plugin {
     per_set_.max = std::max(per_set_.max, n);
     detect_out_.write(detect_, now_ns);
     per_set_out_.write(per_set_, now_ns);
-  }
-
-  static crease::Figure named_figure(const char* label, const char* unit) {
-    crease::Figure f{};
-    std::strncpy(f.label, label, sizeof f.label - 1);
-    std::strncpy(f.unit, unit, sizeof f.unit - 1);
-    std::strncpy(f.sample, "frame sets", sizeof f.sample - 1);
-    return f;
   }
 
   // Non-RT, after a fault too: says why the worker stopped, if it did.

@@ -2,8 +2,6 @@
 
 #include <doctest/doctest.h>
 
-#include <cstring>
-
 #include "core/port.h"
 
 using crease::Figure;
@@ -14,10 +12,7 @@ TEST_CASE("every Figure port is read, with its mean since the previous take, and
   (void)ports.bind_latest_writer("other", crease::PortType{"crease.test.Value", 1, 24}, "x");  // not a figure
   crease::daemon::FigureWatch watch(ports);
   CHECK(watch.take().empty());  // nothing written yet
-  Figure f{};
-  std::strcpy(f.label, "tracking error");
-  std::strcpy(f.unit, "mm");
-  std::strcpy(f.sample, "frames");
+  Figure f = Figure::named("tracking error", "mm", "frames");
   f.count = 4;
   f.sum = 8.0;  // 2 mm each
   f.last = 2.0;

@@ -3,7 +3,6 @@
 
 #include <doctest/doctest.h>
 
-#include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "core/port.h"
@@ -41,10 +40,7 @@ TEST_CASE("the report lists the host's ports, a frame channel with its cameras a
 TEST_CASE("the report and every rendering carry the figures the plugins report; an older report without them reads") {
   crease::PluginHost host({});
   auto* ch = host.ports().bind_latest_writer("detect_time", crease::port_type_of<crease::Figure>(), "vision");
-  crease::Figure f{};
-  std::strcpy(f.label, "vision detection per frame set");
-  std::strcpy(f.unit, "ms");
-  std::strcpy(f.sample, "frame sets");
+  crease::Figure f = crease::Figure::named("vision detection per frame set", "ms", "frame sets");
   f.count = 4;
   f.sum = 100.0;
   f.last = 20.0;

@@ -5,7 +5,6 @@
 #include <doctest/doctest.h>
 #include <unistd.h>
 
-#include <cstring>
 #include <filesystem>
 
 #include "core/port.h"
@@ -98,8 +97,7 @@ TEST_CASE("status, loops and stats views of a host") {
   CHECK_FALSE(s.contains("control"));
   // A figure a plugin reports is in stats.
   auto* fig = host.ports().bind_latest_writer("keypoints_per_set", crease::port_type_of<crease::Figure>(), "vision");
-  crease::Figure f{};
-  std::strcpy(f.label, "vision key-points per frame set");
+  crease::Figure f = crease::Figure::named("vision key-points per frame set", "kp", "frame sets");
   f.count = 2;
   f.sum = 300;
   f.last = 160;
