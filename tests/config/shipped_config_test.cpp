@@ -126,7 +126,10 @@ struct RobotControllers {
     tac.fresh = 1;
     tac.health = crease::DeviceHealth::ok;
     tactile_w->write(&tac, t);
-    loop->run_cycle_rt(crease::rt::CycleClock{k, t, t, 1'000'000});
+    {
+      crease::rt::ScopedRtMark rt;  // only the loop's cycle counts
+      loop->run_cycle_rt(crease::rt::CycleClock{k, t, t, 1'000'000});
+    }
     ++k;
     for (std::size_t s = 0; s < 2; ++s) {
       command_r[s].poll();
@@ -157,7 +160,9 @@ TEST_CASE("config/robot.yaml's hand controllers start limp: enable 0 until a goa
     CHECK(rc.shipped_start["force_r"] == "limp");  // said in the file, not left to a default
     CHECK(rc.shipped_start["force_l"] == "limp");
     bool any_enabled = false, all_limp = true;
+    std::uint64_t allocations_before = 0;
     for (int i = 0; i < 500; ++i) {
+      if (i == 100) allocations_before = crease::rt::rt_allocation_count();  // after a warm-up
       rc.cycle();
       for (std::size_t s = 0; s < 2; ++s) {
         REQUIRE(rc.command_r[s].value().timestamp_ns > 0);  // commanded from the first state on
@@ -181,6 +186,7 @@ TEST_CASE("config/robot.yaml's hand controllers start limp: enable 0 until a goa
     g.id = 7;
     REQUIRE(rc.goal_w[0]->try_push(&g));
     for (int i = 0; i < 10; ++i) rc.cycle();
+    CHECK(crease::rt::rt_allocation_count() - allocations_before == 0);  // limp, and taken over
     const crease::HandCommand& r = rc.command_r[0].value();
     CHECK(r.enable == 1);
     CHECK(rc.status_r[0].value().limp == 0);
