@@ -132,6 +132,7 @@ struct Trials {
   std::vector<long> latency;  // cycles, per trial
   double max_penetration_mm = 0, min_force_at_stop_n = 1e9, max_force_at_stop_n = 0, max_force_after_n = 0;
   int missed = 0;
+  int not_index = 0;  // onsets whose fingers did not include the index (the one touching)
   [[nodiscard]] long worst() const { return latency.empty() ? -1 : *std::max_element(latency.begin(), latency.end()); }
   [[nodiscard]] long best() const { return latency.empty() ? -1 : *std::min_element(latency.begin(), latency.end()); }
   [[nodiscard]] std::string histogram() const {
@@ -160,6 +161,7 @@ Trials right_trials(int n, const std::string& contact_params, double joint_noise
       continue;
     }
     t.latency.push_back(w.first_contact_cycle() - w.first_world_contact_step());
+    if ((w.contact().fingers & 0x01) == 0) ++t.not_index;
     t.min_force_at_stop_n = std::min(t.min_force_at_stop_n, w.force_n());
     t.max_force_at_stop_n = std::max(t.max_force_at_stop_n, w.force_n());
     for (int k = 0; k < after_cycles; ++k) {
@@ -181,6 +183,7 @@ TEST_CASE("C_contact, right hand (config/sim.yaml's contact_r): detected within 
                          << "(cycles); force at the stop " << t.min_force_at_stop_n << " .. " << t.max_force_at_stop_n
                          << " N, at most " << t.max_force_after_n << " N 0.3 s later; worst depth " << t.max_penetration_mm
                          << " mm");
+  CHECK(t.not_index == 0);  // the onset names the finger touching (arm_motion's stop condition is by finger)
   CHECK(t.missed == 0);
   CHECK(t.latency.size() == 24);
   CHECK(t.best() >= 1);   // the world's state reaches the controller one cycle later
