@@ -46,7 +46,7 @@ struct HandControlStatus {
   std::uint8_t saturated = 0;            // bit f: finger f's flexion at its limit
   std::uint8_t commanding = 0;           // 1: hand_command written (a hand_state has been seen)
   std::uint8_t last_refusal = 0;         // GoalRefusal of the last refused goal
-  std::uint8_t reserved = 0;
+  std::uint8_t limp = 0;                 // 1: commanding enable 0 (zero stiffness) until a first goal (`start: limp`)
 
   [[nodiscard]] bool all_finite() const {
     if (!std::isfinite(force_target_n) || !std::isfinite(force_goal_n) || !std::isfinite(max_step_rad)) return false;

@@ -139,7 +139,8 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   path.pose[0] = to_pose(ik_.tool_pose(q_cmd));
   path.count = g.point_count + 1;
   set_path_limits(path, PathLimits{g.speed_mm_s * 1e-3, g.accel_mm_s2 * 1e-3, g.angular_speed_rad_s,
-                                   g.angular_accel_rad_s2, g.stop_accel_mm_s2 * 1e-3});
+                                   g.angular_accel_rad_s2, g.stop_accel_mm_s2 * 1e-3, p_.jerk_mm_s3 * 1e-3,
+                                   p_.angular_jerk_rad_s3, p_.stop_jerk_mm_s3 * 1e-3});
   s_.path = path;
   s_.profile = PathProfile{};
   s_.phase = ArmMotionStatus::checking;

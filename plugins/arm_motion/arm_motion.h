@@ -61,6 +61,11 @@ struct MotionParams {
   double joint_speed_fraction = 0.9;       // of the URDF's velocity limits
   double tracking_tolerance_mm = 0.01;     // the IK residual a running cycle accepts
   double tracking_tolerance_rad = 1e-5;
+  // The trajectory's jerk limits (the goal carries none): along the path (mm/s^3), in rotation
+  // (rad/s^3), and a stop's (mm/s^3, >= jerk_mm_s3). 0: acceleration-limited (cartesian_path.h).
+  double jerk_mm_s3 = 20000;
+  double angular_jerk_rad_s3 = 150;
+  double stop_jerk_mm_s3 = 1000000;
   robot::ArmIk::Options ik;
 };
 

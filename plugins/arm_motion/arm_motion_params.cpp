@@ -53,6 +53,15 @@ ArmMotionConfig parse_arm_motion_params(const Params& p) {
       p.fail("workspace_max_mm", "must exceed workspace_min_mm in every axis (axis " + std::to_string(i) + ")");
     }
   }
+  m.jerk_mm_s3 = p.get_in_range<double>("jerk_mm_s3", m.jerk_mm_s3, 0.0, 1e7);
+  if (m.jerk_mm_s3 > 0) {
+    m.angular_jerk_rad_s3 = p.get_in_range<double>("angular_jerk_rad_s3", m.angular_jerk_rad_s3, 0.01, 1e5);
+    m.stop_jerk_mm_s3 = p.get_in_range<double>("stop_jerk_mm_s3", m.stop_jerk_mm_s3, 1.0, 1e8);
+    if (m.stop_jerk_mm_s3 < m.jerk_mm_s3)
+      p.fail("stop_jerk_mm_s3", "must be at least jerk_mm_s3 (" + format_number(m.jerk_mm_s3) + ")");
+  } else {  // acceleration-limited: no jerk anywhere
+    m.angular_jerk_rad_s3 = m.stop_jerk_mm_s3 = 0;
+  }
   m.arm_state_max_age_s = 1e-3 * p.get_in_range<double>("arm_state_max_age_ms", 5.0, 0.5, 1000.0);
   m.hand_state_max_age_s = 1e-3 * p.get_in_range<double>("hand_state_max_age_ms", 20.0, 0.5, 1000.0);
   m.contact_state_max_age_s = 1e-3 * p.get_in_range<double>("contact_state_max_age_ms", 5.0, 0.5, 1000.0);

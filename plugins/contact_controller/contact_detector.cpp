@@ -56,14 +56,31 @@ void ContactDetector::settle_rt(const ContactInputs& in, const std::array<double
       s_.window_target[static_cast<std::size_t>(j)] = in.command != nullptr ? in.command->target_rad[j] : 0.0f;
     }
     s_.window_sum_kpa.fill(0.0);
+    s_.window_sum_rad.fill(0.0);
+    s_.window_sum2_rad.fill(0.0);
     s_.window_cycles = 0;
   }
   for (int f = 0; f < kFingers; ++f) s_.window_sum_kpa[static_cast<std::size_t>(f)] += kpa[static_cast<std::size_t>(f)];
-  if (++s_.window_cycles < c_.settle_cycles) return;
   for (int j = 0; j < kJoints; ++j) {
-    s_.theta_ref[static_cast<std::size_t>(j)] = h.position_rad[j];
-    s_.target_ref[static_cast<std::size_t>(j)] = in.command != nullptr ? in.command->target_rad[j] : 0.0f;
+    const auto js = static_cast<std::size_t>(j);
+    const double x = static_cast<double>(h.position_rad[j]) - s_.window_theta[js];
+    s_.window_sum_rad[js] += x;
+    s_.window_sum2_rad[js] += x * x;
   }
+  if (++s_.window_cycles < c_.settle_cycles) return;
+  const double n = s_.window_cycles;
+  double noise2 = 0;
+  for (int j = 0; j < kJoints; ++j) {
+    const auto js = static_cast<std::size_t>(j);
+    const double mean = s_.window_sum_rad[js] / n;
+    s_.theta_ref[js] = static_cast<float>(s_.window_theta[js] + mean);  // the window's mean
+    s_.target_ref[js] = in.command != nullptr ? in.command->target_rad[j] : 0.0f;
+    noise2 += c_.weight[js] * std::max(0.0, s_.window_sum2_rad[js] / n - mean * mean);
+  }
+  s_.noise_rad = std::sqrt(noise2);
+  s_.enter_rad = std::max(c_.enter_rad, c_.noise_factor * s_.noise_rad);
+  s_.exit_rad = c_.exit_rad * (s_.enter_rad / c_.enter_rad);
+  s_.spike_rad = 0;
   for (int f = 0; f < kFingers; ++f) {
     const auto fs = static_cast<std::size_t>(f);
     s_.baseline_kpa[fs] = s_.window_sum_kpa[fs] / s_.window_cycles;  // the tare
@@ -75,7 +92,7 @@ void ContactDetector::settle_rt(const ContactInputs& in, const std::array<double
 bool ContactDetector::step_rt(const ContactInputs& in, ContactState& out, ContactEvent& event) noexcept {
   const bool healthy = hand_healthy_rt(in) && tactile_healthy(in);
   out.timestamp_ns = in.time_ns;
-  out.threshold_rad = static_cast<float>(c_.enter_rad);
+  out.threshold_rad = static_cast<float>(s_.armed != 0 ? s_.enter_rad : c_.enter_rad);
   out.healthy = healthy ? 1 : 0;
   auto publish = [&] {
     out.armed = s_.armed;
@@ -144,12 +161,12 @@ bool ContactDetector::step_rt(const ContactInputs& in, ContactState& out, Contac
   }
 
   const bool in_contact = s_.in_contact != 0;
-  const bool joint_raw = total > (in_contact ? c_.exit_rad : c_.enter_rad);
+  const bool joint_raw = total > (in_contact ? s_.exit_rad : s_.enter_rad);
   std::uint8_t fingers = 0;
   std::uint8_t source = joint_raw ? contact_joints : contact_none;
   if (joint_raw) {
     for (int f = 0; f < kFingers; ++f)
-      if (out.finger_deviation_rad[f] > 0.5 * c_.enter_rad) fingers |= static_cast<std::uint8_t>(1u << f);
+      if (out.finger_deviation_rad[f] > 0.5 * s_.enter_rad) fingers |= static_cast<std::uint8_t>(1u << f);
     if (fingers == 0 && most >= 0) fingers = static_cast<std::uint8_t>(1u << most);
   }
   const double tac_threshold = in_contact ? c_.tactile_exit_kpa : c_.tactile_enter_kpa;
@@ -160,6 +177,15 @@ bool ContactDetector::step_rt(const ContactInputs& in, ContactState& out, Contac
     s_.tactile_run[fs] = over ? s_.tactile_run[fs] + 1 : 0;
     if (over) tac_fingers |= static_cast<std::uint8_t>(1u << f);
   }
+  if (joint_raw) {
+    s_.spike_rad = std::max(s_.spike_rad, total);
+  } else if (s_.joint_run > 0 && !in_contact && c_.spike_margin > 0) {  // a spike the debounce rejected
+    ++s_.spikes;
+    const double enter = std::max(s_.enter_rad, c_.spike_margin * s_.spike_rad);
+    s_.exit_rad *= enter / s_.enter_rad;
+    s_.enter_rad = enter;
+  }
+  if (!joint_raw) s_.spike_rad = 0;
   s_.joint_run = joint_raw ? s_.joint_run + 1 : 0;
   if (tac_fingers != 0) {
     fingers |= tac_fingers;

@@ -4,7 +4,15 @@
 //
 //  - Arming: theta_ref is captured once the hand has settled (every selected joint, and its
 //    commanded target when hand_command is read, within settle_band_rad for settle_cycles) while
-//    nothing touches; the tactile baselines are tared over that same window, then follow the
+//    nothing touches: the joints' mean over that window. The window also measures the joints'
+//    noise, sqrt(sum_j w_j var_j) (the P-norm a still hand's readings scatter by), and the
+//    thresholds in use are enter = max(enter_rad, noise_factor x noise), exit scaled with it
+//    (published as threshold_rad): a low enter_rad, down at the sensor's resolution, holds on
+//    joints that read exactly and rises by itself on noisy ones rather than fire on the noise.
+//    Noise too rare for the window (a joint near a quantisation step flickering now and then)
+//    shows as a spike the debounce rejected: out of contact, each rejected joint spike raises
+//    the thresholds in use to spike_margin x its peak deviation (until the next arming).
+//    The tactile baselines are tared over that same window, then follow the
 //    readings slowly (baseline_time_constant_s) while there is no contact (drift). A posture
 //    change of more than rearm_rad in the commanded targets while out of contact disarms: the
 //    hand settles again and a new theta_ref is taken.
@@ -43,6 +51,8 @@ struct ContactConfig {
   double enter_rad = 0.002;              // Delta theta_max
   double exit_rad = 0.001;
   int debounce_cycles = 2;
+  double noise_factor = 3.0;  // enter >= this x the joints' measured noise (0: enter_rad alone)
+  double spike_margin = 1.5;  // enter >= this x a rejected spike's deviation (0: not raised)
   int settle_cycles = 50;
   double settle_band_rad = 0.001;
   double rearm_rad = 0.01;
@@ -69,6 +79,11 @@ class ContactDetector {
   struct State {
     std::array<float, kJoints> theta_ref{}, target_ref{}, window_theta{}, window_target{};
     std::array<double, kFingers> baseline_kpa{}, window_sum_kpa{};
+    std::array<double, kJoints> window_sum_rad{}, window_sum2_rad{};  // of theta - window_theta
+    double enter_rad = 0, exit_rad = 0;  // the thresholds in use (set when it arms)
+    double noise_rad = 0;                // the joints' noise measured when it armed
+    double spike_rad = 0;                // the peak deviation of the joints' current run
+    std::uint64_t spikes = 0;            // joint spikes the debounce rejected
     std::int64_t since_ns = 0;
     std::uint64_t onsets = 0;
     std::int32_t window_cycles = 0;

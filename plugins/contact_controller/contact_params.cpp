@@ -42,6 +42,8 @@ ContactConfig read_contact_config(const Params& p) {
   c.enter_rad = p.get_in_range<double>("enter_rad", c.enter_rad, 1e-5, 1.0);
   c.exit_rad = p.get_in_range<double>("exit_rad", c.exit_rad, 0.0, 1.0);
   if (!(c.exit_rad < c.enter_rad)) p.fail("exit_rad", "must be below enter_rad (the release's hysteresis)");
+  c.noise_factor = p.get_in_range<double>("noise_factor", c.noise_factor, 0.0, 100.0);
+  c.spike_margin = p.get_in_range<double>("spike_margin", c.spike_margin, 0.0, 100.0);
   c.debounce_cycles = p.get_in_range<int>("debounce_cycles", c.debounce_cycles, 1, 1000);
   c.settle_cycles = p.get_in_range<int>("settle_cycles", c.settle_cycles, 1, 100'000);
   c.settle_band_rad = p.get_in_range<double>("settle_band_rad", c.settle_band_rad, 0.0, 0.1);

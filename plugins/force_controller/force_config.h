@@ -43,6 +43,10 @@ struct ForceConfig {
   std::int64_t max_contact_age_ns = 5'000'000;
   double baseline_time_constant_s = 0.5;  // PST tare while a finger is out of contact
   bool anti_windup = true;        // false only to show what it prevents (tests)
+  // start: limp (true): from the first healthy hand_state the hand is commanded enable 0 (zero
+  // stiffness, what the driver does unasked) until a first goal is accepted; hold (false): held
+  // where it is at default_stiffness from that first state.
+  bool start_limp = true;
 };
 
 }  // namespace crease::force

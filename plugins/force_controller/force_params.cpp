@@ -89,6 +89,10 @@ ForceConfig read_force_config(const Params& p) {
   c.max_contact_age_ns = static_cast<std::int64_t>(1e6 * p.get_in_range<double>("max_contact_age_ms", 5.0, 0.0, 1000.0));
   c.baseline_time_constant_s = p.get_in_range<double>("baseline_time_constant_s", c.baseline_time_constant_s, 1e-3, 1e4);
   c.anti_windup = p.get<bool>("anti_windup", true);
+  const std::string start = p.get<std::string>("start", "limp");
+  if (start == "limp") c.start_limp = true;
+  else if (start == "hold") c.start_limp = false;
+  else p.fail("start", "expected limp or hold, got '" + start + "'");
   return c;
 }
 

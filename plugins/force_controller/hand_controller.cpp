@@ -122,6 +122,10 @@ bool HandController::submit_rt(const HandGoal& g, const ForceInputs& in) noexcep
   ++s_.goals_accepted;
   s_.goal_id = g.id;
   s_.inhibit = HandInhibit::none;
+  if (s_.limp != 0) {  // taken over where the limp hand lies
+    for (int j = 0; j < kJoints; ++j) s_.cmd[sz(j)] = in.hand->position_rad[j];
+    s_.limp = 0;
+  }
   switch (g.mode) {
     case HandMode::posture:
       s_.from = s_.cmd;
@@ -252,7 +256,10 @@ bool HandController::step_rt(const ForceInputs& in, HandCommand& command, HandCo
     for (int f = 0; f < kFingers; ++f) s_.baseline_kpa[sz(f)] = in.hand->pressure_kpa[f];
     s_.commanding = 1;
     s_.mode = HandMode::hold;
+    s_.limp = c_.start_limp ? 1 : 0;
   }
+  if (s_.limp != 0 && in.hand != nullptr && bad == HandInhibit::none)  // follow the limp hand
+    for (int j = 0; j < kJoints; ++j) s_.cmd[sz(j)] = in.hand->position_rad[j];
   const std::array<float, kJoints> before = s_.cmd;
   if (s_.commanding != 0) {
     if (bad == HandInhibit::none) {
@@ -261,13 +268,13 @@ bool HandController::step_rt(const ForceInputs& in, HandCommand& command, HandCo
         if (f_[sz(f)] <= c_.force_limit_n || s_.inhibit == HandInhibit::force_limit) continue;
         s_.inhibit = HandInhibit::force_limit;  // whatever the mode or target
         ++s_.inhibits;
-        enter_retreat_rt();
+        if (s_.limp == 0) enter_retreat_rt();  // a limp hand pushes nothing back
         push(HandControlEvent::force_limit_fault, in.time_ns, static_cast<float>(f_[sz(f)]), static_cast<std::uint8_t>(f));
       }
     } else if (s_.inhibit != bad && s_.inhibit != HandInhibit::force_limit) {
       s_.inhibit = bad;  // stop adding force: hold or retreat
       ++s_.inhibits;
-      if (c_.on_bad_input == OnBadInput::retreat) {
+      if (c_.on_bad_input == OnBadInput::retreat && s_.limp == 0) {
         if (s_.mode != HandMode::retreat) enter_retreat_rt();
       } else if (s_.mode != HandMode::retreat) {
         s_.mode = HandMode::hold;
@@ -319,14 +326,15 @@ bool HandController::step_rt(const ForceInputs& in, HandCommand& command, HandCo
   status.settled = s_.settled_since_ns != 0 ? 1 : 0;
   status.saturated = s_.saturated;
   status.commanding = s_.commanding;
+  status.limp = s_.limp;
   status.last_refusal = static_cast<std::uint8_t>(s_.last_refusal);
   if (s_.commanding == 0) return false;
   command.timestamp_ns = in.time_ns;
   for (int j = 0; j < kJoints; ++j) {
     command.target_rad[j] = s_.cmd[sz(j)];
-    command.stiffness_nm_per_rad[j] = s_.stiffness[sz(j)];
+    command.stiffness_nm_per_rad[j] = s_.limp != 0 ? 0.0f : s_.stiffness[sz(j)];
   }
-  command.enable = 1;
+  command.enable = s_.limp != 0 ? 0 : 1;
   return true;
 }
 

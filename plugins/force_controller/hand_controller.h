@@ -26,6 +26,11 @@
 // measured above force_limit_n: retreat and a force_limit_fault event, whatever the mode. A
 // retreat extends every finger's flexion joints by retreat_rad from where force control began
 // (or from the commanded targets), at the rate limit.
+// Start (start_limp): from the first healthy hand_state until a first goal is accepted the
+// command is enable 0 (the hand limp, zero stiffness: what the driver does unasked) with the
+// measured angles as targets; nothing retreats or holds meanwhile (a force-limit fault is still
+// raised). The accepted goal starts from the angles measured then, at default_stiffness (or the
+// posture goal's), so the hand is taken over where it lies.
 // RT: step_rt and submit_rt; the constructor is not.
 #pragma once
 
@@ -77,6 +82,7 @@ class HandController {
     std::uint8_t fingers = 0;
     std::uint8_t saturated = 0;
     std::uint8_t commanding = 0;   // a first hand_state set the command
+    std::uint8_t limp = 0;         // enable 0 commanded, the targets following the hand (start: limp)
     std::uint8_t force_mode_base = 0;  // 1: base holds force mode's start (for a retreat)
   };
 

@@ -9,6 +9,14 @@
 
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
+#include "core/plugin_host.h"
+#include "core/port_types/contact.h"
+#include "core/port_types/hand.h"
+#include "core/port_types/hand_control.h"
+#include "core/port_types/hand_goal.h"
+#include "core/port_types/tactile.h"
+#include "rt/latest.h"
+#include "rt/periodic_loop.h"
 #include "rt/alloc_guard.h"
 #include "sim_cycles.h"
 
@@ -58,4 +66,134 @@ TEST_CASE("config/robot.yaml validates (its plugins need the hardware to configu
   CHECK(cfg.loops.size() == 3);
   CHECK(cfg.find_plugin("hand_r") != nullptr);
   CHECK(cfg.safety.on_fault == crease::config::FaultPolicy::stop);
+}
+
+namespace {
+
+// config/robot.yaml's hand controllers (contact_X, force_X: they need no hardware to configure)
+// in a control loop of their own, stepped here; the test writes both hands' states (and the
+// right hand's taxels) as the drivers would and reads what force_X commands. START: the value
+// force_X's `start` is given (empty: as shipped).
+struct RobotControllers {
+  explicit RobotControllers(const std::string& start) : host({CREASE_PLUGIN_DIR}) {
+    crease::config::LoadOptions o;
+    o.check_plugin_dirs_exist = false;
+    auto cfg = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/robot.yaml", o);
+    loop = &host.add_loop({"control", 1000.0, 0, -1});
+    for (std::size_t i = 0; i < cfg.plugins.size(); ++i) {
+      auto& p = cfg.plugins[i];
+      if (p.library != "contact_controller" && p.library != "force_controller") continue;
+      if (p.library == "force_controller") {
+        shipped_start[p.name] = p.params["start"] ? p.params["start"].as<std::string>() : "(absent)";
+        if (!start.empty()) p.params["start"] = start;
+      }
+      crease::InstanceSpec spec;
+      spec.name = p.name;
+      spec.library = p.library;
+      spec.loop = "control";
+      spec.order = p.order;
+      spec.ports = p.ports;
+      spec.params = crease::Params(p.params, cfg.file, "plugins[" + std::to_string(i) + "].params");
+      spec.budget_ns = 0;  // stepped by the test: no time budget
+      host.add_instance(spec);
+      ++controllers;
+    }
+    auto& ports = host.ports();
+    for (const char* x : {"r", "l"}) {
+      const std::string h = std::string("hand_") + x;
+      state_w.push_back(ports.bind_latest_writer(h + ".state", crease::port_type_of<crease::HandState>(), "test"));
+      command_r.emplace_back(ports.find_latest(h + ".command"));
+      status_r.emplace_back(ports.find_latest(h + ".control_status"));
+      goal_w.push_back(ports.bind_queue_writer(h + ".goal", crease::port_type_of<crease::HandGoal>(), "test", 16));
+    }
+    tactile_w = ports.bind_latest_writer("hand_r.tactile", crease::port_type_of<crease::Tactile>(), "test");
+  }
+  void cycle() {
+    const std::int64_t t = 1'000'000'000 + static_cast<std::int64_t>(k) * 1'000'000;
+    for (std::size_t s = 0; s < 2; ++s) {
+      crease::HandState hs;
+      hs.timestamp_ns = t;
+      hs.valid = (1u << 20) - 1;
+      for (int j = 0; j < crease::HandState::kJoints; ++j) hs.position_rad[j] = 0.05f * static_cast<float>(j % 4);
+      hs.pressure_valid = s == 1 ? 0x1F : 0;
+      hs.fresh = 1;
+      hs.health = crease::DeviceHealth::ok;
+      state_w[s]->write(&hs, t);
+    }
+    crease::Tactile tac;
+    tac.timestamp_ns = t;
+    tac.valid = 0x1F;
+    tac.fresh = 1;
+    tac.health = crease::DeviceHealth::ok;
+    tactile_w->write(&tac, t);
+    {
+      crease::rt::ScopedRtMark rt;  // only the loop's cycle counts
+      loop->run_cycle_rt(crease::rt::CycleClock{k, t, t, 1'000'000});
+    }
+    ++k;
+    for (std::size_t s = 0; s < 2; ++s) {
+      command_r[s].poll();
+      status_r[s].poll();
+    }
+  }
+  crease::PluginHost host;
+  crease::Loop* loop = nullptr;
+  int controllers = 0;
+  std::map<std::string, std::string> shipped_start;
+  std::vector<crease::rt::LatestChannel*> state_w;
+  std::vector<crease::rt::QueueChannel*> goal_w;
+  crease::rt::LatestChannel* tactile_w = nullptr;
+  std::vector<crease::rt::LatestReader<crease::HandCommand>> command_r;
+  std::vector<crease::rt::LatestReader<crease::HandControlStatus>> status_r;
+  std::uint64_t k = 0;
+};
+
+}  // namespace
+
+TEST_CASE("config/robot.yaml's hand controllers start limp: enable 0 until a goal, then held where the hand is "
+          "(failing variant: start: hold, sim.yaml's, holds them at 2 N m/rad from the first cycle)") {
+  for (const char* start_c : {"", "hold"}) {
+    const std::string start = start_c;
+    CAPTURE(start);
+    RobotControllers rc(start);
+    REQUIRE(rc.controllers == 4);  // contact_r, contact_l, force_r, force_l
+    CHECK(rc.shipped_start["force_r"] == "limp");  // said in the file, not left to a default
+    CHECK(rc.shipped_start["force_l"] == "limp");
+    bool any_enabled = false, all_limp = true;
+    std::uint64_t allocations_before = 0;
+    for (int i = 0; i < 500; ++i) {
+      if (i == 100) allocations_before = crease::rt::rt_allocation_count();  // after a warm-up
+      rc.cycle();
+      for (std::size_t s = 0; s < 2; ++s) {
+        REQUIRE(rc.command_r[s].value().timestamp_ns > 0);  // commanded from the first state on
+        const crease::HandCommand& c = rc.command_r[s].value();
+        any_enabled = any_enabled || c.enable != 0;
+        all_limp = all_limp && c.enable == 0 && rc.status_r[s].value().limp == 1;
+        for (float k : c.stiffness_nm_per_rad) all_limp = all_limp && k == 0.0f;
+      }
+    }
+    if (start == "hold") {
+      CHECK(any_enabled);
+      CHECK_FALSE(all_limp);
+      continue;
+    }
+    CHECK_FALSE(any_enabled);
+    CHECK(all_limp);
+    // A hold goal for the right hand: enabled at the measured posture, default stiffness; the
+    // left hand stays limp.
+    crease::HandGoal g;
+    g.mode = crease::HandMode::hold;
+    g.id = 7;
+    REQUIRE(rc.goal_w[0]->try_push(&g));
+    for (int i = 0; i < 10; ++i) rc.cycle();
+    CHECK(crease::rt::rt_allocation_count() - allocations_before == 0);  // limp, and taken over
+    const crease::HandCommand& r = rc.command_r[0].value();
+    CHECK(r.enable == 1);
+    CHECK(rc.status_r[0].value().limp == 0);
+    for (int j = 0; j < crease::HandCommand::kJoints; ++j) {
+      CHECK(r.target_rad[j] == 0.05f * static_cast<float>(j % 4));
+      CHECK(r.stiffness_nm_per_rad[j] == 2.0f);
+    }
+    CHECK(rc.command_r[1].value().enable == 0);
+  }
 }

@@ -129,6 +129,7 @@ class HandWorld {
   void add_force() {
     std::string params = std::string("{side: ") + (right() ? "right" : "left") + ", robot: " + CREASE_SOURCE_DIR +
                          "/config/robot/crease_robot.yaml, default_stiffness: " + std::to_string(o_.stiffness);
+    if (o_.force_params.find("start: ") == std::string::npos) params += ", start: hold";  // the hand held from the start
     if (!o_.force_params.empty()) params += ", " + o_.force_params;
     params += "}";
     crease::InstanceSpec s;

@@ -187,6 +187,10 @@ TEST_CASE("arm_motion's parameters are checked at configure: file, line and key"
   CHECK(e.find("arm.params.max_speed_mm_s: must be in") != std::string::npos);
   e = error_of(params_yaml(", max_stop_accel_mm_s2: 10"));
   CHECK(e.find("arm.params.max_stop_accel_mm_s2: must be at least") != std::string::npos);
+  e = error_of(params_yaml(", jerk_mm_s3: 50000, stop_jerk_mm_s3: 1000"));
+  CHECK(e.find("arm.params.stop_jerk_mm_s3: must be at least jerk_mm_s3 (50000)") != std::string::npos);
+  e = error_of(params_yaml(", jerk_mm_s3: -1"));
+  CHECK(e.find("arm.params.jerk_mm_s3: must be in [0, ") != std::string::npos);
   e = error_of(params_yaml(", workspace_min_mm: [0, 0]"));
   CHECK(e.find("arm.params.workspace_min_mm: expected a list of 3") != std::string::npos);
   e = error_of(params_yaml(", workspace_min_mm: [0, 0, 1000]"));

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "motion_rig.h"
@@ -136,6 +137,76 @@ TEST_CASE("via points are passed exactly, at rest, in order") {
   CHECK(at_rest == 2);
 }
 
+namespace {
+
+// The third difference of three-dimensional samples (m/s^3 at 1 kHz).
+double jerk_m_s3(const std::vector<KDL::Vector>& p, std::size_t i) {
+  return i < 3 ? 0.0 : 1e9 * norm((p[i] - 3 * p[i - 1] + 3 * p[i - 2] - p[i - 3]));
+}
+
+}  // namespace
+
+TEST_CASE("the Cartesian trajectory is jerk-limited over a whole motion with via points and a contact stop (failing "
+          "variant: jerk_mm_s3 0, acceleration-limited)") {
+  for (const bool jerk : {true, false}) {
+    CAPTURE(jerk);
+    MotionParams p = params();
+    if (!jerk) p.jerk_mm_s3 = 0;
+    Rig r(p);
+    idle(r);
+    const KDL::Frame start = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+    ArmGoal g = goal_to(ToolFrame::ff_pad, shifted(start, 40, 0, 0), 1, 100, 1000);
+    add_point(g, shifted(start, 40, 30, -20, KDL::Rotation::RotZ(0.3)));
+    add_point(g, shifted(start, 40, 30, -80, KDL::Rotation::RotZ(0.3)));
+    g.stop_on = ArmGoal::contact_onset;
+    g.stop_fingers = 0x01;
+    REQUIRE(r.cycle(&g));
+    // The path's commanded pose each cycle (what the IK tracks) and the FK of the commanded angles.
+    std::vector<KDL::Vector> path, fk;
+    const auto sample = [&] {
+      const MotionState& st = r.motion->state();
+      path.push_back(pose_at(st.path, st.profile.segment, st.profile.sigma).p);
+      fk.push_back(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)).p);
+    };
+    for (int i = 0; i < 3; ++i) sample();
+    int n = 0;
+    std::size_t stop_at = 0;  // the first sample of the stop
+    while (r.active() && n++ < 20000) {
+      if (r.motion->state().profile.segment == 2 && r.motion->state().profile.sigma > 0.5 && r.contact.onsets == 0) {
+        r.contact.onsets = 1;  // the index finger touches half way down the last segment
+        r.contact.fingers = 0x01;
+        r.contact.in_contact = 1;
+      }
+      r.cycle();
+      sample();
+      if (stop_at == 0 && r.motion->status().state == ArmMotionStatus::stopping) stop_at = path.size() - 1;
+    }
+    for (int i = 0; i < 3; ++i) {
+      r.cycle();
+      sample();
+    }
+    REQUIRE(r.motion->status().state == ArmMotionStatus::stopped_on_contact);
+    REQUIRE(stop_at > 0);
+    double path_jerk = 0, fk_jerk = 0, motion_jerk = 0;
+    for (std::size_t i = 3; i < path.size(); ++i) {
+      path_jerk = std::max(path_jerk, jerk_m_s3(path, i));
+      fk_jerk = std::max(fk_jerk, jerk_m_s3(fk, i));
+      if (i < stop_at) motion_jerk = std::max(motion_jerk, jerk_m_s3(path, i));
+    }
+    MESSAGE(std::string(jerk ? "jerk-limited" : "acceleration-limited") << ": the path's jerk at most " << path_jerk
+            << " m/s^3 (the commanded angles' FK: " << fk_jerk << " m/s^3), over " << path.size() << " cycles");
+    if (jerk) {
+      // The motion's jerk limit before the stop, the stop's from it (MotionParams' defaults:
+      // 20 m/s^3 and 1000 m/s^3).
+      CHECK(motion_jerk <= 1e-3 * p.jerk_mm_s3 * (1 + 1e-6));
+      CHECK(motion_jerk >= 0.95e-3 * p.jerk_mm_s3);
+      CHECK(path_jerk <= 1e-3 * p.stop_jerk_mm_s3 * (1 + 1e-6));
+    } else {
+      CHECK(path_jerk > 10e-3 * MotionParams{}.jerk_mm_s3);  // the acceleration's steps: a / dt (1000 m/s^3 and more)
+    }
+  }
+}
+
 TEST_CASE("a contact onset stops the motion in the same cycle, decelerating within the stop limit") {
   // The variant without a stop condition, the same onset: the motion goes on and reaches.
   for (const bool armed : {true, false}) {
@@ -179,7 +250,9 @@ TEST_CASE("a contact onset stops the motion in the same cycle, decelerating with
       continue;
     }
     CHECK(r.motion->status().state == ArmMotionStatus::stopping);
-    CHECK(t.speed_mm_s(onset) < v_before - 0.5);  // this very cycle's command is slower
+    // This very cycle's command is slower: jerk-limited, by j dt^2 / 6 over the cycle (the
+    // stop's jerk, MotionParams' 1000 m/s^3: 0.17 mm/s), then ever more.
+    CHECK(t.speed_mm_s(onset) < v_before - 0.1);
     while (r.active()) {
       r.cycle();
       t.pose.push_back(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)));
@@ -429,7 +502,7 @@ TEST_CASE("the hand's controller retreating, inhibited or stale stops a running 
         continue;
       }
       CHECK(r.motion->status().state == ArmMotionStatus::stopping);
-      CHECK(t.speed_mm_s(fired) < v_before - 0.5);  // slower in the cycle it saw it
+      CHECK(t.speed_mm_s(fired) < v_before - 0.1);  // slower in the cycle it saw it
       while (r.active()) {
         r.cycle();
         t.pose.push_back(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)));

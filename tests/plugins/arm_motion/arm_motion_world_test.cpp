@@ -3,14 +3,21 @@
 // target within 0.05 mm and 0.1 mrad, scored from world.state(); a descent onto the sheet
 // stopped by a contact onset (taken from the world's own contact flag, standing in for the
 // contact controller) decelerates within the stop limit, measured from the world's applied
-// arm angles.
+// arm angles; and the chain: contact_r's detector (config/sim.yaml's parameters) on the world's
+// hand angles stopping the descent.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+
 #include "motion_rig.h"
+#include "plugins/contact_controller/contact_detector.h"
+#include "plugins/contact_controller/contact_params.h"
 #include "plugins/sim_world/sim_world.h"
 
 using namespace rig;
@@ -176,9 +183,119 @@ TEST_CASE("a descent onto the sheet stopped on the contact onset decelerates wit
   CHECK(max_decel <= 2000.0 + 600.0);
   const std::size_t stop_cycles = p.size() - static_cast<std::size_t>(onset_cycle);
   CHECK(stop_cycles >= 10);  // 20 mm/s at 2000 mm/s^2: 10 ms
-  CHECK(travel_mm <= 20.0 * 20.0 / (2 * 2000.0) + 0.03);  // v^2 / 2a, and one cycle
+  // v^2 / 2a, v a / 2j for the stop's jerk ramps (MotionParams' stop jerk), and one cycle.
+  CHECK(travel_mm <= 20.0 * 20.0 / (2 * 2000.0) + 20.0 * 2000.0 / (2 * MotionParams{}.stop_jerk_mm_s3) + 0.03);
   // Held: the world's arm stays put.
   const KDL::Vector rest = w.pad_applied();
   for (int i = 0; i < 200; ++i) w.cycle();
   CHECK(1e3 * norm((w.pad_applied() - rest)) < 1e-6);
+}
+
+namespace {
+
+// config/sim.yaml's contact_r parameters, its joints' test alone (the taxels read nothing below
+// 0.35 N: plugins/contact_controller/README.md).
+crease::contact::ContactConfig shipped_contact_r(const std::string& extra) {
+  const YAML::Node root = YAML::LoadFile(std::string(CREASE_SOURCE_DIR) + "/config/sim.yaml");
+  YAML::Node params;
+  for (const auto& pl : root["plugins"])
+    if (pl["name"].as<std::string>() == "contact_r") params = YAML::Clone(pl["params"]);
+  REQUIRE(params.IsMap());
+  params["tactile"] = "none";
+  if (!extra.empty()) {
+    const YAML::Node more = YAML::Load(extra);
+    for (auto it = more.begin(); it != more.end(); ++it) params[it->first.as<std::string>()] = it->second;
+  }
+  return crease::contact::read_contact_config(crease::Params(params, "sim.yaml", "contact_r.params"));
+}
+
+}  // namespace
+
+TEST_CASE("the chain on the world: contact_r's Eq. 5 on the world's hand angles stops the jerk-limited descent within 3 "
+          "cycles of the first contact, <= 1 mm deep (failing variant: Delta theta_max 2 mrad)") {
+  for (const bool shipped : {true, false}) {
+    CAPTURE(shipped);
+    WorldRig w;
+    crease::contact::ContactDetector detector(shipped_contact_r(shipped ? "" : "{enter_rad: 0.002, exit_rad: 0.001}"));
+    // Each cycle the detector sees the world's hand after the last step, quantised as on the wire.
+    crease::HandState hs;
+    hs.valid = (1u << 20) - 1;
+    hs.fresh = 1;
+    hs.health = DeviceHealth::ok;
+    crease::HandCommand hc;
+    for (int j = 0; j < robot::kHandJoints; ++j) hc.target_rad[j] = static_cast<float>(w.hand_target[j]);
+    const auto sense = [&] {
+      const auto& h = w.world->hand_angles(Side::right);
+      for (int j = 0; j < robot::kHandJoints; ++j) hs.position_rad[j] = static_cast<float>(std::round(h[j] * 1e4) * 1e-4);
+      hs.timestamp_ns = w.now + kPeriod;
+      crease::contact::ContactInputs in;
+      in.time_ns = hs.timestamp_ns;
+      in.hand = &hs;
+      in.hand_new = true;
+      in.command = &hc;
+      crease::ContactEvent ev;
+      (void)detector.step_rt(in, w.contact, ev);
+    };
+    for (int i = 0; i < 100; ++i) {  // the detector arms on the still hand
+      sense();
+      w.cycle();
+    }
+    REQUIRE(w.contact.armed == 1);
+    const KDL::Frame start(KDL::Rotation::RotX(-0.7) * w.pad().M, w.pad().p);
+    ArmGoal above = goal_to(ToolFrame::ff_pad, KDL::Frame(start.M, KDL::Vector(start.p.x(), start.p.y(), 0.012)), 22, 80, 800);
+    above.angular_speed_rad_s = 0.4f;
+    sense();
+    w.cycle(&above);
+    while (w.active()) {
+      sense();
+      w.cycle();
+    }
+    REQUIRE(w.motion->status().state == ArmMotionStatus::reached);
+    for (int i = 0; i < 100; ++i) {  // settled again at the new pose
+      sense();
+      w.cycle();
+    }
+    REQUIRE(w.contact.armed == 1);
+    REQUIRE(w.contact.in_contact == 0);
+    ArmGoal down = goal_to(ToolFrame::ff_pad, KDL::Frame(start.M, KDL::Vector(start.p.x(), start.p.y(), -0.005)), 23, 20, 200);
+    down.stop_on = ArmGoal::contact_onset;
+    down.stop_fingers = 0x1f;
+    down.stop_accel_mm_s2 = 2000;
+    sense();
+    w.cycle(&down);
+    long k = 0, first_touch = -1, onset = -1;
+    double depth = 0, force_at_onset = 0;
+    for (; k < 5000 && w.active(); ++k) {
+      sense();
+      if (onset < 0 && w.contact.in_contact != 0) {
+        onset = k;
+        for (const auto& t : w.world->state().hand[0].tip) force_at_onset += t.contact != 0 ? t.normal_force_n : 0.0;
+      }
+      w.cycle();
+      bool touching = false;
+      for (const auto& t : w.world->state().hand[0].tip) touching = touching || t.contact != 0;
+      if (touching && first_touch < 0) first_touch = k;
+      depth = std::max(depth, w.world->max_penetration_mm());
+    }
+    for (int i = 0; i < 300; ++i) {
+      sense();
+      w.cycle();
+      depth = std::max(depth, w.world->max_penetration_mm());
+    }
+    double force_after = 0;
+    for (const auto& t : w.world->state().hand[0].tip) force_after += t.contact != 0 ? t.normal_force_n : 0.0;
+    REQUIRE(first_touch >= 0);
+    REQUIRE(onset >= 0);
+    const long latency = onset - first_touch;
+    std::printf("chain (%s): detected %ld cycles after the world's first contact, %.4f N then, %.4f N at rest (all fingertips, "
+                "1 N m/rad); "
+                "worst depth %.4f mm; stopped %s\n",
+                shipped ? "contact_r as shipped" : "2 mrad", latency, force_at_onset, force_after, depth,
+                w.motion->status().state == ArmMotionStatus::stopped_on_contact ? "on contact" : "otherwise");
+    CHECK(w.motion->status().state == ArmMotionStatus::stopped_on_contact);
+    CHECK(depth <= 1.0);
+    CHECK(latency >= 1);
+    if (shipped) CHECK(latency <= 3);
+    else CHECK(latency > 3);
+  }
 }

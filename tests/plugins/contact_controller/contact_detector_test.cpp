@@ -71,6 +71,50 @@ struct Rig {
 
 }  // namespace
 
+TEST_CASE("the thresholds in use rise with the joints' noise measured at arming, and with each spike the debounce "
+          "rejected (failing variant: noise_factor and spike_margin 0)") {
+  for (const bool guarded : {true, false}) {
+    CAPTURE(guarded);
+    Rig r(config(guarded ? "{enter_rad: 0.00005, exit_rad: 0.00003}"
+                         : "{enter_rad: 0.00005, exit_rad: 0.00003, noise_factor: 0, spike_margin: 0}"));
+    // Settling: FFJ3 alternates by 0.2 mrad (a noise of 0.1 mrad about its mean of 0.1 mrad).
+    for (int i = 0; i < 51; ++i) {
+      r.hand.position_rad[FFJ3] = (i % 2 == 0) ? 0.0f : 0.0002f;
+      r.step();
+    }
+    REQUIRE(r.out.armed == 1);
+    if (guarded) CHECK(r.out.threshold_rad == doctest::Approx(3 * 1e-4).epsilon(1e-3));  // noise_factor 3 x 0.1 mrad
+    else CHECK(r.out.threshold_rad == doctest::Approx(5e-5));
+    // The same noise goes on: never a contact when guarded; every other cycle over 50 urad bare.
+    for (int i = 0; i < 200; ++i) {
+      r.hand.position_rad[FFJ3] = (i % 2 == 0) ? 0.0f : 0.0002f;
+      r.step();
+    }
+    CHECK(r.onsets() == (guarded ? 0 : 1));
+  }
+  SUBCASE("a rare spike, unseen while settling, raises the threshold to spike_margin x its peak") {
+    Rig r(config("{enter_rad: 0.00005, exit_rad: 0.00003}"));
+    r.arm();
+    CHECK(r.out.threshold_rad == doctest::Approx(5e-5));
+    r.hand.position_rad[WRJ1] = 0.0001f;  // one cycle one wire unit off, then back
+    r.step();
+    r.hand.position_rad[WRJ1] = 0.0f;
+    r.step();
+    CHECK(r.out.in_contact == 0);
+    CHECK(r.d.state().spikes == 1);
+    CHECK(r.out.threshold_rad == doctest::Approx(1.5e-4).epsilon(1e-3));
+    // Now two cycles in a row of the same spike do not make a contact; 0.2 mrad does.
+    for (int i = 0; i < 2; ++i) {
+      r.hand.position_rad[WRJ1] = 0.0001f;
+      r.step();
+    }
+    CHECK(r.out.in_contact == 0);
+    r.hand.position_rad[WRJ1] = 0.0002f;
+    r.steps(2);
+    CHECK(r.out.in_contact == 1);
+  }
+}
+
 TEST_CASE("C_contact arms once the hand has settled, not while it moves") {
   Rig r(config("{settle_cycles: 50}"));
   for (int i = 0; i < 200; ++i) {  // moving 2 mrad a cycle: never settled

@@ -28,6 +28,7 @@ std::string robot_yaml() { return std::string(CREASE_SOURCE_DIR) + "/config/robo
 ForceConfig config(const std::string& extra = "", const std::string& side = "left") {
   std::string y = "{side: " + side + ", robot: " + robot_yaml() + ", undo_highpass: false";
   if (!extra.empty()) y += ", " + extra;
+  if (extra.find("start: ") == std::string::npos) y += ", start: hold";  // held from the first state
   y += "}";
   return read_force_config(Params(YAML::Load(y), "f.yaml", "force.params"));
 }
@@ -123,6 +124,50 @@ TEST_CASE("before any hand_state nothing is commanded; the first holds the hand 
   for (int j = 0; j < kJoints; ++j) CHECK(r.cmd.target_rad[j] == 0.1f);
   CHECK(r.cmd.stiffness_nm_per_rad[0] == 2.0f);
   CHECK(r.st.mode == HandMode::hold);
+}
+
+TEST_CASE("start: limp (the default): enable 0 following the hand until a goal, then taken over where it lies (failing variant: start: hold)") {
+  for (const bool limp : {true, false}) {
+    CAPTURE(limp);
+    Rig r(config(limp ? "start: limp" : "start: hold"));
+    r.steps(5);
+    REQUIRE(r.commanded);
+    CHECK(r.st.commanding == 1);
+    if (!limp) {  // the failing variant: held stiff from the first state
+      CHECK(r.cmd.enable == 1);
+      CHECK(r.cmd.stiffness_nm_per_rad[FFJ3] == 2.0f);
+      CHECK(r.st.limp == 0);
+      continue;
+    }
+    CHECK(r.cmd.enable == 0);
+    CHECK(r.st.limp == 1);
+    for (int j = 0; j < kJoints; ++j) CHECK(r.cmd.stiffness_nm_per_rad[j] == 0.0f);
+    // The limp hand sags: the targets follow it, nothing resists.
+    for (int i = 0; i < 20; ++i) {
+      r.hand.position_rad[FFJ3] += 0.005f;
+      r.step();
+    }
+    CHECK(r.cmd.enable == 0);
+    CHECK(r.cmd.target_rad[FFJ3] == r.hand.position_rad[FFJ3]);
+    // A bad input meanwhile: it stays limp (nothing retreats), goals refused while it lasts.
+    r.hand.health = DeviceHealth::fault;
+    r.steps(3);
+    CHECK(r.cmd.enable == 0);
+    CHECK(r.st.inhibit == HandInhibit::hand_state_fault);
+    CHECK_FALSE(r.submit(Rig::hold()));
+    r.hand.health = DeviceHealth::ok;
+    r.steps(5);
+    // A hold goal: enabled at default_stiffness where the hand is now, no jump.
+    const float here = r.hand.position_rad[FFJ3];
+    REQUIRE(r.submit(Rig::hold()));
+    r.max_step = 0;
+    r.steps(50);
+    CHECK(r.cmd.enable == 1);
+    CHECK(r.st.limp == 0);
+    CHECK(r.cmd.stiffness_nm_per_rad[FFJ3] == 2.0f);
+    CHECK(r.cmd.target_rad[FFJ3] == here);
+    CHECK(r.max_step == 0.0f);
+  }
 }
 
 TEST_CASE("Eq. 6 presses the finger to 0.5 N and 2 N and holds it; settled is reported (failing variant: k_P = 0)") {
@@ -440,6 +485,7 @@ TEST_CASE("parameters: bad ones are refused with file, line and key") {
   CHECK(error_of("on_bad_input: panic").find("force.params.on_bad_input: expected hold or retreat") != std::string::npos);
   CHECK(error_of("force_limit_n: 2, max_goal_force_n: 3").find("max_goal_force_n: must be below force_limit_n") !=
         std::string::npos);
+  CHECK(error_of("start: stiff").find("force.params.start: expected limp or hold, got 'stiff'") != std::string::npos);
   CHECK(error_of("", "middle").find("force.params.side: expected right or left") != std::string::npos);
   CHECK(error_of("") == "no error");
 }
