@@ -94,7 +94,7 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
   if (!root.has("daemon")) return;
   const MapReader m(root.file(), root.get("daemon"), "daemon",
                     {"socket", "socket_group", "report_dir", "duration_s", "lock_memory",
-                     "prefault_heap_mb", "cpu_dma_latency_us", "non_rt_cpus", "control"});
+                     "prefault_heap_mb", "cpu_dma_latency_us", "non_rt_cpus", "control", "startup_stop_grace_s"});
   const std::string& f = m.file();
   DaemonSettings& d = cfg.daemon;
   d.loc = m.loc();
@@ -133,6 +133,10 @@ void read_daemon(const MapReader& root, DaemonConfig& cfg) {
       cpus.push_back(static_cast<int>(read_int(f, list[i], path + "[" + std::to_string(i) + "]", 0, 1023)));
     }
     d.non_rt_cpus = cpus;
+  }
+  if (m.has("startup_stop_grace_s")) {
+    d.startup_stop_grace_s =
+        read_number(f, m.get("startup_stop_grace_s"), m.path_of("startup_stop_grace_s"), 0.0, 3600.0, false);
   }
   if (m.has("control")) {
     const MapReader c(f, m.get("control"), m.path_of("control"), {"idle_timeout_s", "max_requests_per_s", "max_clients"});

@@ -54,6 +54,10 @@ struct DaemonSettings {
   std::optional<std::vector<int>> non_rt_cpus;
   SourceLoc non_rt_cpus_loc;
   ControlSettings control;
+  // After SIGINT/SIGTERM during start-up: how long the stage under way (a plugin's configure,
+  // the prefault) and the unwinding may take before creased exits without unwinding
+  // (core/daemon/startup_stop.h). [0, 3600] s; 0 = wait for the stage however long.
+  double startup_stop_grace_s = 0.5;
   SourceLoc loc;
 };
 

@@ -46,6 +46,8 @@ class NodeCounter final : public YAML::EventHandler {
   }
   void OnMapEnd() override { close(); }
 
+  [[nodiscard]] std::size_t total() const noexcept { return total_; }
+
  private:
   struct Frame {
     bool map = false;
@@ -138,19 +140,37 @@ void check_yaml_size(const std::string& text, const std::string& file, const Yam
                         " bytes (the limit of a configuration file)");
 }
 
+namespace {
+[[noreturn]] void syntax_error(const std::string& file, const YAML::Exception& e) {
+  throw ConfigError(SourceLoc{file, e.mark.line + 1, e.mark.column + 1}, "(syntax)", e.msg);
+}
+}  // namespace
+
+std::size_t count_yaml_nodes(const std::string& text, const std::string& file, const YamlBounds& bounds) {
+  try {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    NodeCounter counter(file, bounds.max_nodes);
+    parser.HandleNextDocument(counter);
+    return counter.total();
+  } catch (const YAML::Exception& e) {
+    syntax_error(file, e);
+  }
+}
+
+bool node_count_cannot_pass(const std::string& text, const YamlBounds& bounds) noexcept {
+  return text.find('*') == std::string::npos && (text.size() + 1) * kMaxNodesPerByte <= bounds.max_nodes;
+}
+
 YAML::Node load_bounded_yaml(const std::string& text, const std::string& file,
                              const YamlBounds& bounds) {
   check_yaml_size(text, file, bounds);
   try {
-    {
-      std::istringstream in(text);
-      YAML::Parser parser(in);
-      NodeCounter counter(file, bounds.max_nodes);
-      parser.HandleNextDocument(counter);
-    }
+    // The counting pass parses the whole text once more: only where its limit can be passed.
+    if (!node_count_cannot_pass(text, bounds)) (void)count_yaml_nodes(text, file, bounds);
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw ConfigError(SourceLoc{file, e.mark.line + 1, e.mark.column + 1}, "(syntax)", e.msg);
+    syntax_error(file, e);
   }
 }
 

@@ -33,19 +33,27 @@ const std::string& require_scalar(const std::string& file, const YAML::Node& nod
   return node.Scalar();
 }
 
-std::size_t edit_distance(const std::string& a, const std::string& b) {
+// The case-insensitive edit distance of A and B, or LIMIT when it is LIMIT or more. Two words
+// whose lengths differ by LIMIT are that far apart already (a fuzzed key of a thousand bytes
+// costs nothing), and a row whose every cell has reached LIMIT ends it (a row's minimum never
+// decreases).
+std::size_t edit_distance_below(const std::string& a, const std::string& b, std::size_t limit) {
+  if ((a.size() > b.size() ? a.size() - b.size() : b.size() - a.size()) >= limit) return limit;
   std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
   for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
     cur[0] = i;
+    std::size_t row_min = cur[0];
     for (std::size_t j = 1; j <= b.size(); ++j) {
       const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
                         std::tolower(static_cast<unsigned char>(b[j - 1]));
       cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (same ? 0 : 1)});
+      row_min = std::min(row_min, cur[j]);
     }
+    if (row_min >= limit) return limit;
     std::swap(prev, cur);
   }
-  return prev[b.size()];
+  return std::min(prev[b.size()], limit);
 }
 
 }  // namespace
@@ -64,9 +72,9 @@ SourceLoc loc_of(const std::string& file, const YAML::Node& node) {
 
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
   std::string best;
-  std::size_t best_d = 3;
+  std::size_t best_d = 3;  // a candidate is only suggested within distance 2
   for (const auto& c : candidates) {
-    const std::size_t d = edit_distance(word, c);
+    const std::size_t d = edit_distance_below(word, c, best_d);
     if (d < best_d) {
       best_d = d;
       best = c;

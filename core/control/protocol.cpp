@@ -107,14 +107,25 @@ std::int64_t require_int(const nlohmann::json& request, const char* name) {
   return v.get<std::int64_t>();
 }
 
+// Built key by key: an initializer list builds each member as a two-item array first and then
+// takes it apart (allocations per member, on every reply).
 nlohmann::json make_ok(const nlohmann::json& id, nlohmann::json result) {
-  return nlohmann::json{{"id", id}, {"ok", true}, {"result", std::move(result)}};
+  nlohmann::json reply(nlohmann::json::value_t::object);
+  reply["id"] = id;
+  reply["ok"] = true;
+  reply["result"] = std::move(result);
+  return reply;
 }
 
 nlohmann::json make_error(const nlohmann::json& id, const std::string& code,
                           const std::string& message) {
-  return nlohmann::json{
-      {"id", id}, {"ok", false}, {"error", {{"code", code}, {"message", message}}}};
+  nlohmann::json reply(nlohmann::json::value_t::object);
+  reply["id"] = id;
+  reply["ok"] = false;
+  nlohmann::json& error = reply["error"];
+  error["code"] = code;
+  error["message"] = message;
+  return reply;
 }
 
 std::string to_line(const nlohmann::json& reply) {

@@ -1,7 +1,8 @@
 #include "core/control/request_parser.h"
 
 #include <cmath>
-#include <set>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "core/control/protocol.h"
@@ -54,32 +55,86 @@ std::string type_error(const json& v, ArgType t) {
   return "has an unknown type";
 }
 
+// The parser's events (nlohmann's SAX interface) into the request's DOM, with every object's
+// keys checked as they are read: the first key an object has twice is noted, and from there
+// on nothing is built (the request is refused whatever follows; the parse goes on only to
+// tell a text that is not JSON at all). One map insertion per key: no callback per event, no
+// second set of keys.
+class StrictDom {
+ public:
+  explicit StrictDom(json& root) : root_(root) {}
+
+  bool null() { return put(json(nullptr)), true; }
+  bool boolean(bool v) { return put(json(v)), true; }
+  bool number_integer(json::number_integer_t v) { return put(json(v)), true; }
+  bool number_unsigned(json::number_unsigned_t v) { return put(json(v)), true; }
+  bool number_float(json::number_float_t v, const json::string_t&) { return put(json(v)), true; }
+  bool string(json::string_t& v) { return put(json(std::move(v))), true; }
+  bool binary(json::binary_t& v) { return put(json(std::move(v))), true; }  // not in JSON text
+  bool start_object(std::size_t) { return open(json::value_t::object); }
+  bool start_array(std::size_t) { return open(json::value_t::array); }
+  bool end_object() { return close(); }
+  bool end_array() { return close(); }
+  bool key(json::string_t& k) {
+    if (duplicate_) return true;
+    auto& object = open_.back()->get_ref<json::object_t&>();
+    const auto [it, inserted] = object.try_emplace(std::move(k));  // K stays when it is there
+    if (inserted) {
+      slot_ = &it->second;
+    } else {
+      duplicate_ = true;
+      duplicate_key_ = k;
+    }
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) { return false; }
+
+  [[nodiscard]] bool duplicate() const noexcept { return duplicate_; }
+  [[nodiscard]] const std::string& duplicate_key() const noexcept { return duplicate_key_; }
+
+ private:
+  // V as the next value: the root, the next item of the open array, or the value of the key
+  // just read. nullptr once a duplicate stopped the building.
+  json* put(json&& v) {
+    if (duplicate_) return nullptr;
+    if (open_.empty()) {
+      root_ = std::move(v);
+      return &root_;
+    }
+    json& top = *open_.back();
+    if (top.is_array()) {
+      auto& items = top.get_ref<json::array_t&>();
+      items.push_back(std::move(v));
+      return &items.back();  // valid while open: its array takes no item until it is closed
+    }
+    *slot_ = std::move(v);
+    return slot_;
+  }
+  bool open(json::value_t t) {
+    if (json* c = put(json(t))) open_.push_back(c);
+    return true;
+  }
+  bool close() {
+    if (!duplicate_) open_.pop_back();
+    return true;
+  }
+
+  json& root_;
+  std::vector<json*> open_;  // the containers being read, outermost first
+  json* slot_ = nullptr;     // the value of the key just read
+  bool duplicate_ = false;
+  std::string duplicate_key_;
+};
+
 }  // namespace
 
 ParsedRequest parse_request(std::string_view line) {
-  // The callback sees every key as it is read: one set of keys per open object.
-  std::vector<std::set<std::string>> open_objects;
-  std::string duplicate;
-  bool has_duplicate = false;
-  const json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start: open_objects.emplace_back(); break;
-      case json::parse_event_t::object_end:
-        if (!open_objects.empty()) open_objects.pop_back();
-        break;
-      case json::parse_event_t::key:
-        if (!open_objects.empty() && !open_objects.back().insert(parsed.get<std::string>()).second && !has_duplicate) {
-          has_duplicate = true;
-          duplicate = parsed.get<std::string>();
-        }
-        break;
-      default: break;
-    }
-    return true;
-  };
-  json req = json::parse(line.begin(), line.end(), track, false);
-  if (req.is_discarded()) return failure(nullptr, kErrorMalformed, "request is not JSON");
-  if (has_duplicate) return failure(nullptr, kErrorMalformed, "request has the key '" + printable(duplicate) + "' twice");
+  json req;
+  StrictDom dom(req);
+  if (!json::sax_parse(line.begin(), line.end(), &dom)) return failure(nullptr, kErrorMalformed, "request is not JSON");
+  if (dom.duplicate()) {
+    return failure(nullptr, kErrorMalformed, "request has the key '" + printable(dom.duplicate_key()) + "' twice");
+  }
   if (!req.is_object()) return failure(nullptr, kErrorMalformed, "request is not a JSON object");
   json id = req.contains("id") ? req["id"] : json(nullptr);
   const auto cmd = req.find("cmd");

@@ -94,8 +94,9 @@ Daemon::Daemon(config::DaemonConfig config, Options options) : config_(std::move
   for (const auto& l : config_.loops) host_->add_loop({l.name, l.rate_hz, l.priority, l.cpu, l.phase_ns});
   for (std::size_t i = 0; i < config_.plugins.size(); ++i) {
     const auto& p = config_.plugins[i];
-    check_startup_stop("before plugin " + std::to_string(i + 1) + " of " + std::to_string(config_.plugins.size()) +
-                       " ('" + p.name + "')");
+    const std::string which = "plugin " + std::to_string(i + 1) + " of " + std::to_string(config_.plugins.size()) +
+                              " ('" + p.name + "')";
+    check_startup_stop("before " + which, which + ": its load, configure and activate");
     try {
       host_->add_instance(to_spec(p, config_.safety, config_.file, i));
     } catch (const std::exception& e) {
@@ -115,12 +116,12 @@ Daemon::~Daemon() {
 
 int Daemon::run() {
   const auto& d = config_.daemon;
-  check_startup_stop("after loading every plugin");
+  check_startup_stop("after loading every plugin", d.lock_memory ? "locking and prefaulting memory" : "starting the control socket");
   if (d.lock_memory) {
     const auto step = rt::lock_memory(static_cast<std::size_t>(d.prefault_heap_mb) << 20);
     facts_.mlockall_applied = step.applied;
     log_step(step);
-    check_startup_stop("after locking and prefaulting memory");
+    check_startup_stop("after locking and prefaulting memory", "starting the control socket");
   }
   log_step(non_rt_step_);
   rt::DmaLatencyRequest dma;
@@ -137,7 +138,8 @@ int Daemon::run() {
   so.max_clients = static_cast<std::size_t>(d.control.max_clients);
   server_ = std::make_unique<control::ControlServer>(so, *this);
   server_->start();  // before the loops: its threads' creation is done when they take deadlines
-  check_startup_stop("before starting the loops");
+  // The start-up watch ends here: a signal from now on is the loop below's to take.
+  finish_startup("before starting the loops");
 
   facts_.start_ns = rt::now_ns();
   facts_.sched_fifo_applied = true;

@@ -38,8 +38,9 @@ class Daemon final : public control::RequestHandler {
 
   // Starts the loops and the control server; returns when stopped (signal, `stop`, duration,
   // safety policy). Drives outputs safe, deactivates in reverse order, writes the reports.
-  // Returns the exit status (0). A SIGINT/SIGTERM pending before the loops start throws
-  // StartupStopped (startup_stop.h), as does one during construction, between plugins.
+  // Returns the exit status (0). A SIGINT/SIGTERM before the loops start throws
+  // StartupStopped (startup_stop.h), as does one during construction, between plugins; with a
+  // StartupWatch in the process, a stage still under way past its grace ends the process.
   int run();
   void request_stop() noexcept { stop_.store(true); }
 

@@ -2,13 +2,15 @@
 //   creased --config FILE [--socket PATH] [--duration SECONDS] [--report-dir DIR]
 //           [--log-level LEVEL] [--plugin-dir DIR]... [--no-progress] [--set INSTANCE.KEY=VALUE]...
 // Exit status: 0 after a clean stop (also a SIGINT/SIGTERM during start-up: what was built is
-// unwound, no loop runs), 2 for a configuration or plugin error (nothing started), 1 for any
-// other failure.
+// unwound, no loop runs; a stage still under way daemon.startup_stop_grace_s after the signal
+// is cut short: startup_stop.h), 2 for a configuration or plugin error (nothing started), 1 for
+// any other failure.
 #include <signal.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,11 +58,22 @@ int main(int argc, char** argv) {
   // Under systemd, journald adds time and unit: keep lines short.
   if (std::getenv("JOURNAL_STREAM") != nullptr) spdlog::set_pattern("[%l] %v");
 
+  // From here until the loops start, a thread of its own takes SIGINT/SIGTERM: honoured at the
+  // next stage, or within the grace if a stage takes longer (startup_stop.h).
+  std::optional<crease::daemon::StartupWatch> watch;
+  try {
+    watch.emplace();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "creased: %s\n", e.what());
+    return 1;
+  }
   std::unique_ptr<crease::daemon::Daemon> daemon;
   try {
+    watch->enter("reading the configuration");
     crease::config::DaemonConfig config = crease::config::load_daemon_config(config_file);
     for (const std::string& o : overrides) crease::config::override_param(config, o);
-    crease::daemon::check_startup_stop("after reading the configuration");
+    watch->set_grace(config.daemon.startup_stop_grace_s);
+    crease::daemon::check_startup_stop("after reading the configuration", "placing the threads and loading the plugins");
     daemon = std::make_unique<crease::daemon::Daemon>(std::move(config), options);
   } catch (const crease::daemon::StartupStopped& e) {  // what was built is unwound by now
     std::printf("creased: %s; no loop ran\n", e.what());

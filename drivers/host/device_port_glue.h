@@ -34,10 +34,13 @@ class DeviceFaultReport {
  public:
   explicit DeviceFaultReport(int device_fault_cycles = 50) noexcept : cycles_(device_fault_cycles) {}
   // The read phase's verdict, after the host read the bus.
-  Status update(LinkHealth h, const LinkMonitor& monitor) noexcept {
-    fault_run_ = h == LinkHealth::fault ? fault_run_ + 1 : 0;
+  Status update(LinkHealth h, const LinkMonitor& monitor) noexcept { return update(h, monitor.past_start_up()); }
+  // The same for a link without a LinkMonitor (the tactile link): PAST_START_UP says whether it
+  // has answered once or had its first-contact cycles to do so.
+  Status update(LinkHealth h, bool past_start_up) noexcept {
+    fault_run_ = h != LinkHealth::fault ? 0 : fault_run_ < cycles_ ? fault_run_ + 1 : cycles_;  // saturates
     if (h == LinkHealth::ok) status_ = Status::ok;
-    else if (fault_run_ >= cycles_ && monitor.past_start_up()) status_ = Status::device_fault;
+    else if (fault_run_ >= cycles_ && past_start_up) status_ = Status::device_fault;
     else status_ = Status::degraded;
     return status_;
   }
@@ -46,7 +49,7 @@ class DeviceFaultReport {
 
  private:
   int cycles_;
-  int fault_run_ = 0;  // consecutive cycles in fault
+  int fault_run_ = 0;  // consecutive cycles in fault, at most cycles_
   Status status_ = Status::degraded;
 };
 

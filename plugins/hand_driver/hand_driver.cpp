@@ -31,6 +31,10 @@
 // first answered) with health = fault in
 // hand_state: the plugin stays scheduled so it recovers by itself when the device returns,
 // sending the newest command, never a backlog. Before the first command arrives it holds.
+// The tactile link likewise: stale samples (older than 20 ms: health fault in `tactile`) are
+// Status::degraded, and Status::device_fault once they lasted device_fault_cycles after the
+// sensor's first sample (or its 1000 first-contact cycles); the hand is not made safe for it
+// (its controllers see the tactile port's health), and the report recovers with the samples.
 #include <memory>
 #include <string>
 
@@ -54,6 +58,8 @@ class HandDriver final : public Plugin {
     dr::HandHostConfig cfg;
     bus_ = dr::configure_can_device(p, cfg, 1);
     report_ = dr::DeviceFaultReport(cfg.monitor.device_fault_cycles);
+    tactile_report_ = dr::DeviceFaultReport(cfg.monitor.device_fault_cycles);
+    tactile_first_contact_cycles_ = static_cast<std::uint64_t>(cfg.monitor.first_contact_cycles);
     cfg.pressure_sensors = p.get<bool>("pressure_sensors", false);
     host_ = std::make_unique<dr::HandHost>(*bus_, cfg);
     if (p.has("tactile_device")) {
@@ -80,6 +86,7 @@ class HandDriver final : public Plugin {
 
   // Non-RT: the tactile link's thread runs while the instance is scheduled.
   void activate() override {
+    tactile_cycles_ = 0;
     if (tactile_) tactile_->start();
   }
   void deactivate() override {
@@ -112,7 +119,8 @@ class HandDriver final : public Plugin {
       tactile_out_value_.sample_counter = s.sample_counter;
       tactile_out_value_.valid = s.valid;
       tactile_out_value_.fresh = got ? 1 : 0;
-      tactile_out_value_.health = dr::to_device_health(tactile_->health(now));
+      const dr::LinkHealth tactile_health = tactile_->health(now);
+      tactile_out_value_.health = dr::to_device_health(tactile_health);
       tactile_out_value_.age_ns = tactile_->samples() ? now - tactile_out_value_.timestamp_ns : 0;
       const dr::TactileCounters c = tactile_->counters();
       tactile_out_value_.frames = tactile_->samples();
@@ -121,8 +129,13 @@ class HandDriver final : public Plugin {
       for (int f = 0; f < Tactile::kFingertips; ++f)
         for (int t = 0; t < Tactile::kTaxels; ++t) tactile_out_value_.pressure_kpa[f][t] = s.pressure_kpa[f][t];
       tactile_out_.write(tactile_out_value_, now);
-      if (tactile_out_value_.health != DeviceHealth::ok) status = worst(status, Status::degraded);
+      // The sensor silent (or its samples stale) for device_fault_cycles after it first
+      // answered, or after its first-contact cycles, is a device fault as the hand's would be.
+      if (tactile_cycles_ < tactile_first_contact_cycles_) ++tactile_cycles_;
+      const bool past_start_up = tactile_->samples() > 0 || tactile_cycles_ >= tactile_first_contact_cycles_;
+      status = worst(status, tactile_report_.update(tactile_health, past_start_up));
     }
+    status_ = status;
     return status;
   }
 
@@ -142,12 +155,16 @@ class HandDriver final : public Plugin {
       for (int j = 0; j < HandCommand::kJoints; ++j) cmd.target_rad[j] = r.status.position_rad[j];
     }
     host_->write_from_rt(cmd, stiff, cycle.time_ns);
-    return report_.status();
+    return status_;
   }
 
  private:
   std::unique_ptr<dr::CanBus> bus_;
-  dr::DeviceFaultReport report_;
+  dr::DeviceFaultReport report_;          // the hand's CAN link
+  dr::DeviceFaultReport tactile_report_;  // the tactile link
+  std::uint64_t tactile_cycles_ = 0;      // updates since activate, up to the first-contact cycles
+  std::uint64_t tactile_first_contact_cycles_ = 1000;
+  Status status_ = Status::degraded;      // this cycle's verdict of both links (update's, again in write)
   std::unique_ptr<dr::HandHost> host_;
   std::unique_ptr<dr::SerialPort> serial_;
   std::unique_ptr<dr::TactileReader> tactile_;  // after serial_: stopped before the port closes

@@ -372,6 +372,15 @@ TEST_CASE("daemon.control: the control socket's limits per client, defaults on")
         std::string::npos);
 }
 
+TEST_CASE("daemon.startup_stop_grace_s: how long a start-up stage may outlast a stop, 0.5 s by default") {
+  CHECK(cfg::load_daemon_config_from_string(HEAD, "c.yaml", kNoDirCheck).daemon.startup_stop_grace_s ==
+        doctest::Approx(0.5));
+  CHECK(cfg::load_daemon_config_from_string(HEAD "daemon: {startup_stop_grace_s: 0}\n", "c.yaml", kNoDirCheck)
+            .daemon.startup_stop_grace_s == 0.0);
+  CHECK(error_of(HEAD "daemon: {startup_stop_grace_s: -1}\n") ==
+        "/etc/crease/bad.yaml:6:32: daemon.startup_stop_grace_s: must be in [0, 3600], got -1");
+}
+
 TEST_CASE("the firewall's limits per instance: budget {time_us, cycles} and on_rt_allocation, with safety's default") {
   const std::string head = HEAD;
   const auto c = cfg::load_daemon_config_from_string(

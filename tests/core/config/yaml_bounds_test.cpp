@@ -5,6 +5,7 @@
 
 #include <doctest/doctest.h>
 
+#include <random>
 #include <string>
 
 #include "core/errors.h"
@@ -81,4 +82,35 @@ TEST_CASE("an alias inside the node it names is a cycle; YAML errors keep their 
   cfg::YamlBounds b;
   b.max_nodes = 6;
   CHECK(error_of("p:\n  - {q: [1, 2]}\n", b).find("bomb.yaml:2:10: p[0].q[0]: more than 6 nodes") == 0);
+}
+
+// load_bounded_yaml skips its counting pass for a text without aliases too short to hold more
+// than max_nodes nodes at 3 per byte plus one (node_count_cannot_pass, with one per byte to
+// spare). The claim itself, on random texts of YAML's punctuation: counted with max_nodes at
+// 3 (bytes + 1), none passes it, also before a syntax error ends the count.
+TEST_CASE("a text without aliases has at most 3 nodes per byte plus one; shorter texts skip the count") {
+  std::mt19937 rng(11);
+  const std::string alphabet = "?:-[]{},\n a!&#|>'\"";
+  int counted = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::string t(1 + rng() % 16, ' ');
+    for (char& c : t) c = alphabet[rng() % alphabet.size()];
+    cfg::YamlBounds b;
+    b.max_nodes = 3 * (t.size() + 1);
+    CAPTURE(t);
+    try {
+      (void)cfg::count_yaml_nodes(t, "r.yaml", b);
+      ++counted;
+    } catch (const crease::ConfigError& e) {
+      CHECK(std::string(e.what()).find("(syntax)") != std::string::npos);  // never "more than"
+    }
+  }
+  CHECK(counted > 1000);
+  cfg::YamlBounds b;
+  b.max_nodes = 100;
+  CHECK(cfg::node_count_cannot_pass(std::string(24, 'x'), b));
+  CHECK_FALSE(cfg::node_count_cannot_pass(std::string(25, 'x'), b));
+  CHECK_FALSE(cfg::node_count_cannot_pass("a: *x", b));  // an alias: counted whatever the size
+  // Below the bound the verdicts are the counting pass's: a syntax error keeps its place.
+  CHECK(error_of("a: [1, 2\n", {}) == error_of("a: [1, 2\n" + std::string(30000, '#'), {}));
 }

@@ -23,89 +23,11 @@
 
 #include "core/control/control_client.h"
 #include "rt/thread_placement.h"
+#include "tests/core/daemon/creased_process.h"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-namespace {
-const std::string kBin = CREASE_BIN_DIR;
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    char tmpl[] = "/tmp/crease-e2e-XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
-std::string config_text(const std::string& extra_plugin = "") {
-  return std::string("plugin_dirs: [") + CREASE_PLUGIN_DIR + "]\n"
-         "loops:\n"
-         "  - {name: control, rate_hz: 1000, priority: 0}\n"
-         "plugins:\n"
-         "  - name: counter\n"
-         "    library: crease_test_counter_v1\n"
-         "    loop: control\n"
-         "    order: 1\n" +
-         extra_plugin;
-}
-
-struct Run {
-  int status = -1;
-  std::string out;
-};
-
-// Runs a shell command, returns its exit status and output (stdout + stderr).
-Run sh(const std::string& cmd) {
-  Run r;
-  FILE* f = popen((cmd + " 2>&1").c_str(), "r");
-  REQUIRE(f != nullptr);
-  char buf[4096];
-  while (std::fgets(buf, sizeof(buf), f) != nullptr) r.out += buf;
-  const int rc = pclose(f);
-  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  return r;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-// Starts creased on CFG (its output in DIR/creased.log) with a socket and a report folder, a
-// 60 s bound; returns its pid.
-pid_t start_creased(const fs::path& dir, const fs::path& cfg, const std::string& sock, const fs::path& reports) {
-  const pid_t pid = fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    const std::string out = (dir / "creased.log").string();
-    std::freopen(out.c_str(), "w", stdout);
-    std::freopen(out.c_str(), "a", stderr);
-    execl((kBin + "/creased").c_str(), "creased", "--config", cfg.c_str(), "--socket", sock.c_str(), "--report-dir",
-          reports.c_str(), "--duration", "60", "--no-progress", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  return pid;
-}
-
-// Waits (at most 10 s) until creased listens on SOCK (the file exists from bind(), a moment
-// before listen(): a connection in between is refused).
-bool wait_for_socket(const std::string& sock) {
-  for (int i = 0; i < 400; ++i) {
-    if (fs::exists(sock)) {
-      try {
-        crease::control::ControlClient probe(sock);
-        return true;
-      } catch (const crease::control::ClientError&) {
-      }
-    }
-    std::this_thread::sleep_for(25ms);
-  }
-  return false;
-}
-}  // namespace
+using namespace crease::test::e2e;
 
 TEST_CASE("creased runs, creasectl steers it, reports come out in every format") {
   TempDir tmp;
@@ -256,81 +178,6 @@ TEST_CASE("non-real-time threads stay off a pinned loop's CPU; threads view and 
   CHECK(slurp(reports / "report.txt").find("# non-real-time threads on CPUs: " + others) != std::string::npos);
 }
 
-// True once PID blocks SIGINT and SIGTERM (main's first step, before anything is built): a
-// signal sent from then on is creased's to take, not the default action's.
-bool blocks_stop_signals(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("SigBlk:", 0) != 0) continue;
-    const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
-    return (mask >> (SIGINT - 1) & 1) != 0 && (mask >> (SIGTERM - 1) & 1) != 0;
-  }
-  return false;
-}
-
-// A start-up of 20 plugins that take 0.5 s each to configure (10 s in all), then loops that
-// would run: a signal sent as soon as creased takes signals ends it before its next stage,
-// no loop runs, and it says so. Without the check between stages it starts everything, runs
-// the loops and only then stops ("creased running" in its log).
-TEST_CASE("SIGTERM or SIGINT during start-up: creased stops at the next stage, no loop runs, exit 0") {
-  for (const int sig : {SIGTERM, SIGINT}) {
-    CAPTURE(sig);
-    TempDir tmp;
-    const fs::path cfg = tmp.path / "slow.yaml";
-    {
-      std::ofstream out(cfg);
-      out << config_text();
-      for (int i = 0; i < 20; ++i) {
-        out << "  - {name: slow" << i << ", library: crease_test_slow_configure, loop: control, order: " << 10 + i
-            << ", params: {configure_ms: 500}, ports: {out: slow" << i << "}}\n";
-      }
-    }
-    const std::string sock = (tmp.path / "creased.sock").string();
-    const fs::path reports = tmp.path / "reports";
-    const pid_t pid = start_creased(tmp.path, cfg, sock, reports);
-    bool blocked = false;
-    for (int i = 0; i < 1000 && !blocked; ++i) {
-      blocked = blocks_stop_signals(pid);
-      if (!blocked) std::this_thread::sleep_for(5ms);
-    }
-    REQUIRE(blocked);
-    const auto t0 = std::chrono::steady_clock::now();
-    REQUIRE(::kill(pid, sig) == 0);
-    int wstatus = 0;
-    bool exited = false;
-    for (int i = 0; i < 1200 && !exited; ++i) {  // a hang guard of 60 s, the run's --duration
-      exited = waitpid(pid, &wstatus, WNOHANG) == pid;
-      if (!exited) std::this_thread::sleep_for(50ms);
-    }
-    if (!exited) {
-      ::kill(pid, SIGKILL);
-      waitpid(pid, &wstatus, 0);
-    }
-    REQUIRE(exited);
-    MESSAGE("creased exited " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
-                              << " s after the signal (its start-up alone is 10 s)");
-    const std::string log = slurp(tmp.path / "creased.log");
-    CAPTURE(log);
-    REQUIRE(WIFEXITED(wstatus));
-    CHECK(WEXITSTATUS(wstatus) == 0);
-    const std::string said = std::string("creased: stopped by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM") +
-                             " during start-up, ";
-    REQUIRE(log.find(said) != std::string::npos);
-    CHECK(log.find("no loop ran") != std::string::npos);
-    CHECK(log.find("creased running") == std::string::npos);
-    // It stopped at one of the first stages (the signal is sent while the configuration is
-    // read or the first plugins configure), never after the 20 slow plugins were configured.
-    const std::string stage = log.substr(log.find(said) + said.size());
-    CAPTURE(stage);
-    const bool at_config = stage.rfind("after reading the configuration", 0) == 0;
-    const bool at_plugin = stage.rfind("before plugin ", 0) == 0 && stage.find(" of 21 (") != std::string::npos &&
-                           std::stoi(stage.substr(14)) <= 20;
-    CHECK((at_config || at_plugin));
-    CHECK_FALSE(fs::exists(sock));
-    CHECK_FALSE(fs::exists(reports));
-  }
-}
 
 // The firewall in the running daemon: a 1500 us plugin in the 1 kHz loop is stopped by its
 // time budget (the loop's period by default); an allocating plugin's heap allocations are

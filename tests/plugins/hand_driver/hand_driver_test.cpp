@@ -294,3 +294,20 @@ TEST_CASE("hand_driver: tactile samples at the sensor's rate reach the port in o
                           << ", CRC errors " << end.crc_errors);
   CHECK(end.frames + end.overruns == sensor.samples_sent());
 }
+
+// The tactile sensor falls silent while the hand goes on answering: once its samples have been
+// stale for device_fault_cycles the instance reports a device fault (counted by the host,
+// health fault, still scheduled), and recovers when the sensor streams again. With the tactile
+// link reported as Status::degraded only (as it was), the host counted no device fault: the
+// rig's checks of device_faults and health fail.
+TEST_CASE("hand_driver: a silent tactile sensor is a device fault in the host, and recovers when it streams again") {
+  TactileRig t;
+  dr::sim::SimTactile sensor(t.pty.master_fd());
+  dr::sim::DeviceThread sdev(t.pty.master_fd(), [&](std::int64_t now) { sensor.step(now); });
+  t.rig.host.start();
+  REQUIRE(eventually([&] { return t.tactile().health == DeviceHealth::ok; }));
+  t.rig.check_device_fault_and_recovery([&] { sensor.set_silent(true); }, [&] { sensor.set_silent(false); });
+  CHECK(t.rig.wait_for(link_ok).health == DeviceHealth::ok);  // the hand's own link is sound
+  CHECK(eventually([&] { return t.tactile().health == DeviceHealth::ok; }));
+  t.rig.host.stop();
+}
