@@ -3,7 +3,8 @@
 // away (a flap folded past 90 deg shows the cameras its back). Each key-point id keeps its
 // last two observations; its predicted world position at time t is the last one plus
 // (t - t_last) times the velocity between the two, for at most max_extrapolate_s after it was
-// last seen: after that it is no longer predicted, and the model's physics holds that part.
+// last seen (while newer observations leave it out): after that it is no longer predicted, and
+// the model's physics holds that part.
 // With bound_by_sheet, a key-point that was not in the newest observation is kept within its
 // sheet distance (plus slack_mm) of every key-point that was: paper does not stretch, so two
 // sheet points are never further apart in the world than on the sheet. Constant velocity
@@ -55,8 +56,10 @@ class KeypointPredictor {
         if (!s.seen || n >= static_cast<int>(out.size())) continue;
         const bool fresh = s.t >= newest_t_;  // in the newest observation
         if (fresh != (pass == 0)) continue;
-        const double age = t_s - s.t;
-        if (age > p_.max_extrapolate_s) continue;
+        // Unseen: missing from observations for longer than max_extrapolate_s (counted from the
+        // newest, so a slow or late vision frame drops nothing it still shows).
+        if (!fresh && newest_t_ - s.t > p_.max_extrapolate_s) continue;
+        const double age = std::min(t_s - s.t, p_.max_extrapolate_s);  // extrapolated at most this long
         const Vec3 p = s.has_vel && age > 0 ? s.world + age * s.vel : s.world;
         out[n++] = {p, s.sheet};
       }

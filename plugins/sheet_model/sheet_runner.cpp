@@ -101,7 +101,11 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
     model_->set_targets(all);
   }
   const double memory = model_->params().predictor.unseen_speed_memory_s;
-  if (memory > 0) {
+  const SolverParams& sp = model_->params().solver;
+  fit_good_s_ = last_fit_mm_ <= sp.learn_fit_mm ? fit_good_s_ + dt_s : 0.0;
+  const bool fits = fit_good_s_ >= sp.learn_after_s;
+  model_->set_unseen_speed_limit(0.0);  // none while the model catches up with what it sees
+  if (memory > 0 && fits) {
     // At least 1 mm/s (a limit of 0 would be none). The key-points predicted through a gap
     // [seen_count, n_obs) are not seen; the external targets are commands, as good as seen.
     const InputRange predicted{predictor_.seen_count(), n_obs};
@@ -110,9 +114,7 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
                                    springs ? predicted : InputRange{},
                                    springs ? InputRange{} : predicted);
   }
-  const SolverParams& sp = model_->params().solver;
-  fit_good_s_ = last_fit_mm_ <= sp.learn_fit_mm ? fit_good_s_ + dt_s : 0.0;
-  model_->set_links_learn(observations_ == 0 || fit_good_s_ >= sp.learn_after_s);
+  model_->set_links_learn(observations_ == 0 || fits);
   model_->save_links_rt();  // with last_good_: the state this step starts from
   model_->step_rt(dt_s);
   ++steps_;

@@ -42,11 +42,27 @@ TEST_CASE("an unseen key-point is predicted within its sheet distance of the see
 }
 
 TEST_CASE("a key-point is no longer predicted soon after it was last seen") {
-  CHECK(run(PredictorParams{}, 0.1 + 0.19).size() == 2);
-  CHECK(run(PredictorParams{}, 0.1 + 0.21).size() == 1);  // 0.2 s after it was last seen
+  auto seen_later = [](const PredictorParams& p, double t_newest) {
+    KeypointPredictor k(2, p);
+    k.observe(0, {0, 0}, {0, 0, 0}, 0.0);
+    k.observe(1, {100, 0}, {100, 0, 0}, 0.0);
+    k.observe(0, {0, 0}, {0, 0, 0}, t_newest);  // key-point 1 left out since 0 s
+    std::vector<TargetPoint> out(2);
+    return k.predict(t_newest + 0.01, out);
+  };
+  CHECK(seen_later(PredictorParams{}, 0.19) == 2);
+  CHECK(seen_later(PredictorParams{}, 0.21) == 1);  // left out of observations for 0.2 s
   PredictorParams before;
   before.max_extrapolate_s = 1.5;
-  CHECK(run(before, 0.1 + 1.4).size() == 2);
+  CHECK(seen_later(before, 1.4) == 2);
+  // A key-point in the newest observation stays however late the next one is (a slow vision
+  // frame drops nothing), extrapolated at most max_extrapolate_s.
+  KeypointPredictor k(1, PredictorParams{});
+  k.observe(0, {0, 0}, {0, 0, 0}, 0.0);
+  k.observe(0, {0, 0}, {0, 0, 1}, 0.1);  // 10 mm/s up
+  std::vector<TargetPoint> out(1);
+  REQUIRE(k.predict(5.0, out) == 1);
+  CHECK(out[0].world_mm.z == doctest::Approx(1.0 + 0.2 * 10.0));
 }
 
 TEST_CASE("the fastest speed seen is remembered for a while") {
