@@ -22,6 +22,25 @@
 #include "core/daemon/startup_stop.h"
 #include "core/errors.h"
 
+namespace {
+
+// --record-state / --record-truth: `key` of the configuration's one sheet_score instance.
+void record_override(crease::config::DaemonConfig& config, const char* flag, const char* key, const std::string& file) {
+  if (file.empty()) return;
+  std::string instance;
+  for (const auto& p : config.plugins) {
+    if (p.library != "sheet_score") continue;
+    if (!instance.empty())
+      throw crease::ConfigError(std::string(flag) + ": " + config.file + " has several sheet_score instances ('" +
+                                instance + "', '" + p.name + "'): use --set INSTANCE." + key + "=FILE");
+    instance = p.name;
+  }
+  if (instance.empty()) throw crease::ConfigError(std::string(flag) + ": " + config.file + " has no sheet_score instance");
+  crease::config::override_param(config, instance + "." + key + "=" + file);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   // Signals are taken by the main thread with sigtimedwait: block them before any thread exists.
   sigset_t signals;
@@ -48,6 +67,11 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   app.add_option("--set", overrides, "INSTANCE.KEY=VALUE: a plugin parameter instead of the configuration's "
                                      "(repeatable), e.g. --set score.record=state.jsonl");
+  std::string record_state, record_truth;
+  app.add_option("--record-state", record_state,
+                 "FILE: the sheet_score instance records every model frame there (its `record`), for crease-score");
+  app.add_option("--record-truth", record_truth,
+                 "FILE: the sheet_score instance records the truth there (its `record_truth`), for crease-score");
   CLI11_PARSE(app, argc, argv);
   if (!socket.empty()) options.socket = socket;
   if (duration > 0) options.duration_s = duration;
@@ -72,6 +96,8 @@ int main(int argc, char** argv) {
     watch->enter("reading the configuration");
     crease::config::DaemonConfig config = crease::config::load_daemon_config(config_file);
     for (const std::string& o : overrides) crease::config::override_param(config, o);
+    record_override(config, "--record-state", "record", record_state);
+    record_override(config, "--record-truth", "record_truth", record_truth);
     watch->set_grace(config.daemon.startup_stop_grace_s);
     crease::daemon::check_startup_stop("after reading the configuration", "placing the threads and loading the plugins");
     daemon = std::make_unique<crease::daemon::Daemon>(std::move(config), options);

@@ -155,7 +155,7 @@ void OdeSheet::substep(double dts) noexcept {
     dBodySetLinearVel(bodies_[i], v_[i].x, v_[i].y, v_[i].z);
   }
   // Plasticity (seed 001 III.C) on the joints' rest lengths.
-  if (sp.plasticity_rate > 0) {
+  if (sp.plasticity_rate > 0 && links_learn_) {
     for (int k = 0; k < link_count(); ++k) {
       if (sp.plastic_bending_only && topo_.kind[k] != LinkKind::bending) continue;
       const double l = rest_[k];
@@ -179,6 +179,7 @@ void OdeSheet::step_rt(double dt) noexcept {
   for (const Vec3& v : v_) vmax = std::max(vmax, norm(v));
   layers_.detect_rt(x_, world_, std::min(2.0 + 1.5 * vmax * dt, 30.0));
   for (int s = 0; s < ns; ++s) substep(dts);
+  (void)infer_creases_rt();  // solver.crease_strain > 0 only
 }
 
 }  // namespace crease::sheet

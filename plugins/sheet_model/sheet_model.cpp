@@ -29,6 +29,7 @@ SheetModel::SheetModel(const SheetParams& params)
           "must be in [0, 1)");
   require(s.yield_strain >= 0, "solver.yield_strain", "must be >= 0");
   require(s.plasticity_every >= 1, "solver.plasticity_every", "must be >= 1");
+  require(s.crease_strain >= 0, "solver.crease_strain", "must be >= 0");
   require(s.damping_per_s >= 0, "solver.damping_per_s", "must be >= 0");
   require(params_.grid.areal_density_g_per_m2 > 0, "grid.areal_density_g_per_m2", "must be > 0");
   require(params_.grid.thickness_mm > 0, "grid.thickness_mm", "must be > 0");
@@ -52,6 +53,7 @@ SheetModel::SheetModel(const SheetParams& params)
   plastic_.assign(m, 0.0);
   stiffness_.assign(m, s.stiffness);
   compliance_.assign(m, 0.0);
+  inferred_.assign(m, 0);
   for (int k = 0; k < m; ++k) rest_[k] = norm(flat_[topo_.b[k]] - flat_[topo_.a[k]]);
   pinned_.assign(n, 0);
   pin_pos_.assign(n, Vec3{});
@@ -65,6 +67,7 @@ SheetModel::SheetModel(const SheetParams& params)
   saved_plastic_ = plastic_;
   saved_stiffness_ = stiffness_;
   saved_compliance_ = compliance_;
+  saved_inferred_ = inferred_;
   saved_creases_ = creases_;
   saved_version_ = links_version_;
 }
@@ -76,6 +79,8 @@ Vec3 SheetModel::flat_position(Vec2 p) const noexcept {
 
 void SheetModel::reset_rt() noexcept {
   creases_.clear();
+  std::fill(inferred_.begin(), inferred_.end(), std::uint8_t{0});
+  n_inferred_ = 0;
   for (int k = 0; k < link_count(); ++k) {
     rest_[k] = norm(flat_[topo_.b[k]] - flat_[topo_.a[k]]);
     plastic_[k] = 0.0;
@@ -95,7 +100,7 @@ void SheetModel::restore_link_stiffness() noexcept {
   const int m = link_count();
   const Grid& g = topo_.grid;
   for (int k = 0; k < m; ++k) {
-    double s = params_.solver.stiffness;
+    double s = inferred_[k] ? params_.solver.crease_stiffness : params_.solver.stiffness;
     const Vec2 p = g.sheet_of(topo_.a[k]), q = g.sheet_of(topo_.b[k]);
     for (int c = 0; c < CreaseSet::kCapacity; ++c) {
       if (creases_.used(c) && segments_cross(p, q, creases_.line(c).a, creases_.line(c).b)) {
@@ -113,6 +118,30 @@ int SheetModel::add_crease(CreaseLine line) noexcept {
   const int id = creases_.add(line);
   if (id >= 0) restore_link_stiffness();
   return id;
+}
+
+int SheetModel::infer_creases_rt() noexcept {
+  const double limit = params_.solver.crease_strain;
+  if (!(limit > 0) || !links_learn_) return 0;
+  const auto x = positions();
+  const double cs = params_.solver.crease_stiffness;
+  int cut = 0;
+  for (int k = 0; k < link_count(); ++k) {
+    if (inferred_[k] || topo_.kind[k] != LinkKind::bending) continue;
+    const double l = rest_[k] + plastic_[k];
+    if (!(l > 0) || std::fabs(norm(x[topo_.b[k]] - x[topo_.a[k]]) - l) <= limit * l) continue;
+    inferred_[k] = 1;
+    if (stiffness_[k] > cs) {
+      stiffness_[k] = cs;
+      compliance_[k] = link_base_compliance(k) / cs;
+    }
+    ++cut;
+  }
+  if (cut > 0) {
+    n_inferred_ += cut;
+    ++links_version_;
+  }
+  return cut;
 }
 
 bool SheetModel::remove_crease(int id) noexcept {
@@ -242,6 +271,8 @@ void SheetModel::save_links_rt() noexcept {
     std::copy(stiffness_.begin(), stiffness_.end(), saved_stiffness_.begin());
     std::copy(compliance_.begin(), compliance_.end(), saved_compliance_.begin());
     std::copy(plastic_.begin(), plastic_.end(), saved_plastic_.begin());
+    std::copy(inferred_.begin(), inferred_.end(), saved_inferred_.begin());
+    saved_n_inferred_ = n_inferred_;
     saved_creases_ = creases_;
     saved_version_ = links_version_;
     saved_plastic_version_ = plastic_version_;
@@ -256,6 +287,8 @@ void SheetModel::restore_links_rt() noexcept {
   std::copy(saved_stiffness_.begin(), saved_stiffness_.end(), stiffness_.begin());
   std::copy(saved_compliance_.begin(), saved_compliance_.end(), compliance_.begin());
   std::copy(saved_plastic_.begin(), saved_plastic_.end(), plastic_.begin());
+  std::copy(saved_inferred_.begin(), saved_inferred_.end(), inferred_.begin());
+  n_inferred_ = saved_n_inferred_;
   creases_ = saved_creases_;
   ++links_version_;  // backends re-read rest lengths and compliances
   saved_version_ = links_version_;

@@ -44,6 +44,12 @@ struct SheetPointStencil {
   std::array<double, 4> alpha{};
 };
 
+// A range [first, last) of a model's current inputs (targets or key-points).
+struct InputRange {
+  int first = 0, last = 0;
+  [[nodiscard]] bool has(int i) const noexcept { return i >= first && i < last; }
+};
+
 class SheetModel {
  public:
   static constexpr int kMaxTargets = 4096;
@@ -69,6 +75,14 @@ class SheetModel {
   int add_crease(CreaseLine line) noexcept;  // id, or -1 when full
   bool remove_crease(int id) noexcept;
   [[nodiscard]] const CreaseSet& creases() const noexcept { return creases_; }
+  // A crease inferred from the strain (solver.crease_strain > 0; the backends call it once per
+  // frame): every bending link whose |strain| passes crease_strain takes crease_stiffness and
+  // keeps it until reset_rt. Returns the links newly cut. RT.
+  int infer_creases_rt() noexcept;
+  // Whether the links learn this frame: the plastic update and infer_creases_rt (default on). RT.
+  void set_links_learn(bool on) noexcept { links_learn_ = on; }
+  [[nodiscard]] bool links_learn() const noexcept { return links_learn_; }
+  [[nodiscard]] int inferred_crease_links() const noexcept { return n_inferred_; }
 
   // Memorize (seed 000): rest length := current length, permanent elongation := 0. RT.
   void memorize_all() noexcept;
@@ -79,6 +93,16 @@ class SheetModel {
   int set_keypoints(std::span<const KeypointObs> k) noexcept;
   int set_targets(std::span<const TargetPoint> t) noexcept;
   void set_keypoint_gain(double lambda_per_s) noexcept { keypoint_gain_ = lambda_per_s; }
+  // Nodes that no target or key-point of the current inputs touches move no faster than this
+  // (mm/s; <= 0 or not finite: no limit beyond solver.max_speed_mm_per_s). RT.
+  // Inputs predicted through a gap rather than seen: targets [first, last) and key-points
+  // [first, last) of the current inputs; the nodes only they touch count as unseen.
+  void set_unseen_speed_limit(double mm_per_s, InputRange predicted_targets = {},
+                              InputRange predicted_keypoints = {}) noexcept {
+    unseen_speed_limit_ = mm_per_s;
+    predicted_targets_ = predicted_targets;
+    predicted_keypoints_ = predicted_keypoints;
+  }
   void clear_inputs() noexcept { n_keypoints_ = 0; n_targets_ = 0; }
 
   // A pinned node follows a prescribed position (infinite mass). RT.
@@ -140,6 +164,8 @@ class SheetModel {
   std::vector<std::uint8_t> pinned_;
   std::vector<Vec3> pin_pos_;
   CreaseSet creases_;
+  std::vector<std::uint8_t> inferred_;  // per link: cut by infer_creases_rt
+  int n_inferred_ = 0;
   std::vector<KeypointObs> keypoints_;  // capacity kMaxKeypoints
   std::vector<SheetPointStencil> keypoint_stencil_;
   int n_keypoints_ = 0;
@@ -147,12 +173,17 @@ class SheetModel {
   std::vector<SheetPointStencil> target_stencil_;
   int n_targets_ = 0;
   double keypoint_gain_ = 10.0;
+  double unseen_speed_limit_ = 0.0;  // mm/s, <= 0: none
+  bool links_learn_ = true;
+  InputRange predicted_targets_, predicted_keypoints_;  // predicted, not seen
   const CollisionWorld* world_ = nullptr;
   std::uint64_t links_version_ = 0;
   std::uint64_t plastic_version_ = 0;  // backends: +1 whenever a plastic elongation changed
 
  private:
   std::vector<double> saved_rest_, saved_plastic_, saved_stiffness_, saved_compliance_;
+  std::vector<std::uint8_t> saved_inferred_;
+  int saved_n_inferred_ = 0;
   CreaseSet saved_creases_;
   std::uint64_t saved_version_ = ~std::uint64_t{0};
   std::uint64_t saved_plastic_version_ = ~std::uint64_t{0};

@@ -12,8 +12,14 @@
 // coupling (how the key-points pull the model: `springs` (default), seed 001's zero-length
 // springs of compliance target_compliance_m_per_n; or `keypoints`, seed 000's node-velocity
 // P-controller of gain keypoint_gain_per_s), keypoint_gain_per_s, target_compliance_m_per_n,
-// compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
-// self_collision (0/1), self_collision_every (1..100 substeps; the last substep always).
+// compliance_bending_m_per_n, damping_per_s, yield_strain and plasticity_rate (seed 001's
+// elasto-plastic bending links: how the model holds a fold nobody announced; defaults in
+// sheet_params.h), crease_strain (a crease inferred from the strain; 0: off), table_height_mm,
+// self_collision (0/1), self_collision_every (1..100 substeps; the last substep always),
+// predict_unseen_s (how long a key-point is still predicted after it was last seen),
+// bound_predictions (0/1: unseen key-points kept within their sheet distance of the seen),
+// unseen_speed_memory_s (nodes no key-point pulls move no faster than the fastest key-point
+// seen within this many seconds; 0: off).
 #include <memory>
 #include <string>
 
@@ -49,8 +55,13 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
     sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
-    sp.solver.yield_strain = p.get_in_range<double>("yield_strain", 0.0, 0.0, 1.0);
-    sp.solver.plasticity_rate = p.get_in_range<double>("plasticity_rate", 0.0, 0.0, 0.99);
+    sp.solver.yield_strain = p.get_in_range<double>("yield_strain", sp.solver.yield_strain, 0.0, 1.0);
+    sp.solver.plasticity_rate = p.get_in_range<double>("plasticity_rate", sp.solver.plasticity_rate, 0.0, 0.99);
+    sp.solver.crease_strain = p.get_in_range<double>("crease_strain", sp.solver.crease_strain, 0.0, 10.0);
+    sp.predictor.max_extrapolate_s = p.get_in_range<double>("predict_unseen_s", sp.predictor.max_extrapolate_s, 0.0, 10.0);
+    sp.predictor.unseen_speed_memory_s =
+        p.get_in_range<double>("unseen_speed_memory_s", sp.predictor.unseen_speed_memory_s, 0.0, 1e3);
+    sp.predictor.bound_by_sheet = p.get_in_range<int>("bound_predictions", 1, 0, 1) != 0;
     sp.solver.self_collision = p.get_in_range<int>("self_collision", 1, 0, 1) != 0;
     // Layer contacts enforced every this many substeps (and always on the last one).
     sp.solver.self_collision_every = p.get_in_range<int>("self_collision_every", 2, 1, 100);

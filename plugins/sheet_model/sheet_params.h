@@ -60,10 +60,23 @@ struct SolverParams {
   double compliance_bending_m_per_n = 0.05;     // alpha of a bending link at stiffness 1
   double stiffness = 0.9;          // seed 000 default link stiffness coefficient (0..1]
   double crease_stiffness = 0.001; // stiffness of links crossing a crease (seed 000 code)
-  // Elasto-plastic links (seed 001 III.C); plasticity_rate 0 disables it.
-  double yield_strain = 0.0;       // eps_Y
-  double plasticity_rate = 0.0;    // a in [0, 1)
+  // Elasto-plastic links (seed 001 III.C); plasticity_rate 0 disables it. With crease_strain
+  // below, how the tracking model holds a fold nobody announced (crease-bench sheet_hold:
+  // plugins/sheet_model/README.md): a bending link yields beyond 5 % strain and keeps 95 % of
+  // what it is strained past that.
+  double yield_strain = 0.05;      // eps_Y
+  double plasticity_rate = 0.95;   // a in [0, 1)
   bool plastic_bending_only = true;
+  // A crease inferred from the strain (0: off): a bending link whose |strain| passes this takes
+  // crease_stiffness, as if a crease crossed it, until reset_rt (SheetModel::infer_creases_rt,
+  // once per frame).
+  double crease_strain = 0.03;
+  // SheetRunner lets the links learn (plastic update, inferred creases) only while the model
+  // fits what it sees: the mean key-point distance at most learn_fit_mm for learn_after_s in a
+  // row, or nothing seen. A model still catching up with its observations (a first sighting, a
+  // jump) strains its links with the solver's lag, not the sheet's shape.
+  double learn_fit_mm = 2.0;
+  double learn_after_s = 0.2;
   // The plastic update runs after every this many substeps, counted across frames (1: after
   // every substep). The rule depends on elongations only, not on time: a world stepping 1 ms
   // frames of a few substeps can update every few ms and pay a fraction of the link pass.
@@ -83,10 +96,22 @@ struct SolverParams {
   int self_collision_every = 2;
 };
 
+// How SheetRunner predicts the observed key-points to each model step (keypoint_predictor.h).
+struct PredictorParams {
+  double max_gap_s = 0.25;         // two observations further apart give no velocity
+  double max_extrapolate_s = 0.2;  // an unseen key-point is predicted this long, then dropped
+  bool bound_by_sheet = true;      // unseen key-points within their sheet distance of the seen
+  double slack_mm = 1.0;           // the bound's allowance for observation noise
+  // Nodes no key-point pulls move no faster than the fastest key-point seen within this many
+  // seconds (SheetModel::set_unseen_speed_limit); 0: no such limit (max_speed_mm_per_s only).
+  double unseen_speed_memory_s = 3.0;
+};
+
 struct SheetParams {
   GridParams grid;
   TopologyParams topology;
   SolverParams solver;
+  PredictorParams predictor;
 };
 
 }  // namespace crease::sheet

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "sheet_state_writer.h"
@@ -13,7 +14,7 @@ SheetRunner::SheetRunner(const SheetParams& params, double table_height_mm)
     : SheetRunner(std::make_unique<XpbdSheet>(params), table_height_mm) {}
 
 SheetRunner::SheetRunner(std::unique_ptr<SheetModel> model, double table_height_mm)
-    : model_(std::move(model)), predictor_(kMarkerIds * 5), coupling_(model_->params().solver.coupling) {
+    : model_(std::move(model)), predictor_(kMarkerIds * 5, model_->params().predictor), coupling_(model_->params().solver.coupling) {
   if (std::isfinite(table_height_mm)) {
     world_.add_table(table_height_mm);
     model_->set_collision_world(&world_);
@@ -74,6 +75,8 @@ void SheetRunner::apply(const SheetMemorizeEvent& e) noexcept {
 
 void SheetRunner::apply(const SheetResetEvent&) noexcept {
   model_->reset_rt();
+  last_fit_mm_ = std::numeric_limits<double>::infinity();
+  fit_good_s_ = 0;
   predictor_.clear();
   n_external_ = 0;
   last_good_.assign(model_->positions().begin(), model_->positions().end());
@@ -97,6 +100,21 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
   } else {
     model_->set_targets(all);
   }
+  const double memory = model_->params().predictor.unseen_speed_memory_s;
+  const SolverParams& sp = model_->params().solver;
+  fit_good_s_ = last_fit_mm_ <= sp.learn_fit_mm ? fit_good_s_ + dt_s : 0.0;
+  const bool fits = fit_good_s_ >= sp.learn_after_s;
+  model_->set_unseen_speed_limit(0.0);  // none while the model catches up with what it sees
+  if (memory > 0 && fits) {
+    // At least 1 mm/s (a limit of 0 would be none). The key-points predicted through a gap
+    // [seen_count, n_obs) are not seen; the external targets are commands, as good as seen.
+    const InputRange predicted{predictor_.seen_count(), n_obs};
+    const bool springs = coupling_ != Coupling::keypoints;
+    model_->set_unseen_speed_limit(std::max(predictor_.fastest_speed(seconds(now_ns), memory), 1.0),
+                                   springs ? predicted : InputRange{},
+                                   springs ? InputRange{} : predicted);
+  }
+  model_->set_links_learn(observations_ == 0 || fits);
   model_->save_links_rt();  // with last_good_: the state this step starts from
   model_->step_rt(dt_s);
   ++steps_;
@@ -123,6 +141,7 @@ void SheetRunner::fill_state(std::int64_t now_ns, SheetState& out) noexcept {
     ++used;
   }
   out.fit_error_mm = used > 0 ? static_cast<float>(err / used) : -1.0f;
+  last_fit_mm_ = used > 0 ? err / used : std::numeric_limits<double>::infinity();
   out.observations = observations_;
   out.rollbacks = rollbacks_;
 }

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -65,6 +66,10 @@ class SheetRunner {
   std::uint64_t steps_ = 0;
   std::uint32_t rollbacks_ = 0;
   std::uint32_t observations_ = 0;
+  // The last state's fit error; infinite when it saw nothing (the first frame that sees again
+  // does not learn).
+  double last_fit_mm_ = std::numeric_limits<double>::infinity();
+  double fit_good_s_ = 0;  // how long the fit has been within solver.learn_fit_mm
 };
 
 }  // namespace crease::sheet

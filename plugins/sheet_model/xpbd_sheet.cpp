@@ -67,6 +67,8 @@ XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
   cpu_simd_ = cpu_has_avx2_fma() && node_passes_simd_available();
   simd_ = cpu_simd_;
   keep_.assign(3 * static_cast<std::size_t>(n), -1);
+  touched_.assign(n, 0);
+  unseen_.assign(n, 0);
   const SolverParams& s = params_.solver;
   if (s.plasticity_rate > 0) {
     for (int k = 0; k < link_count(); ++k)
@@ -164,6 +166,44 @@ void XpbdSheet::update_plasticity() noexcept {
   if (changed) ++plastic_version_;
 }
 
+void XpbdSheet::mark_unseen() noexcept {
+  std::fill(touched_.begin(), touched_.end(), std::uint8_t{0});
+  for (int t = 0; t < n_targets_; ++t)
+    for (int e = 0; e < 4 && !predicted_targets_.has(t); ++e)
+      if (target_stencil_[t].bilinear[e] > 0) touched_[target_stencil_[t].node[e]] = 1;
+  const auto ks = keypoint_gain_ > 0 ? keypoint_stencils() : std::span<const SheetPointStencil>{};  // gain 0: they pull nothing
+  for (int k = 0; k < static_cast<int>(ks.size()); ++k)
+    for (int e = 0; e < 4 && !predicted_keypoints_.has(k); ++e)
+      if (ks[k].bilinear[e] > 0) touched_[ks[k].node[e]] = 1;  // the cell it lies in, as a target's
+  // A node within kSeenReach grid cells of a touched one is seen too: the nodes between the
+  // markers are the observed sheet, only a part with no key-point near it is hidden.
+  const Grid& g = grid();
+  n_unseen_ = 0;
+  for (int j = 0; j < g.h; ++j)
+    for (int i = 0; i < g.w; ++i) {
+      const int k = g.index(i, j);
+      if (pinned_[k]) continue;
+      bool near = false;
+      for (int b = std::max(0, j - kSeenReach); b <= std::min(g.h - 1, j + kSeenReach) && !near; ++b)
+        for (int a = std::max(0, i - kSeenReach); a <= std::min(g.w - 1, i + kSeenReach) && !near; ++a)
+          near = touched_[g.index(a, b)] != 0;
+      if (!near) unseen_[n_unseen_++] = k;
+    }
+}
+
+// As the speed limit of update_velocities_rt, with the unseen nodes' own limit.
+void XpbdSheet::limit_unseen(double dts) noexcept {
+  const double cap = unseen_speed_limit_;
+  for (int k = 0; k < n_unseen_; ++k) {
+    const int i = unseen_[k];
+    const double sp2 = dot(v_[i], v_[i]);
+    if (sp2 > cap * cap) {
+      v_[i] *= cap / std::sqrt(sp2);
+      x_[i] = prev_[i] + dts * v_[i];
+    }
+  }
+}
+
 void XpbdSheet::detect_contacts(double dt) noexcept {
   const int n = node_count();
   double vmax2 = 0, moved2 = 0;
@@ -200,6 +240,8 @@ void XpbdSheet::step_rt(double dt) noexcept {
   const double dts = dt / ns;
   prepare_frame(dts);
   prepare_targets(dts);
+  const bool limit_unseen_nodes = unseen_speed_limit_ > 0 && std::isfinite(unseen_speed_limit_);
+  if (limit_unseen_nodes) mark_unseen();
   detect_contacts(dt);
 
   const double damp = std::max(0.0, 1.0 - sp.damping_per_s * dts);
@@ -215,9 +257,11 @@ void XpbdSheet::step_rt(double dt) noexcept {
     const int every = std::max(1, sp.self_collision_every);
     contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);
     update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit
+    if (limit_unseen_nodes) limit_unseen(dts);
     ++substeps_done_;
-    if (!plastic_links_.empty() && substeps_done_ % plastic_every == 0) update_plasticity();
+    if (links_learn_ && !plastic_links_.empty() && substeps_done_ % plastic_every == 0) update_plasticity();
   }
+  (void)infer_creases_rt();  // solver.crease_strain > 0 only; the next frame re-reads the links
 }
 
 }  // namespace crease::sheet

@@ -57,6 +57,8 @@ class XpbdSheet final : public SheetModel {
   void prepare_targets(double dt_s) noexcept;
   void project_targets() noexcept;
   void update_plasticity() noexcept;
+  void mark_unseen() noexcept;
+  void limit_unseen(double dts) noexcept;
   void detect_contacts(double dt_s) noexcept;
 
   std::vector<Vec3> x_, v_, prev_;
@@ -75,6 +77,9 @@ class XpbdSheet final : public SheetModel {
   std::uint64_t prepared_version_ = ~std::uint64_t{0};
   double prepared_dt_ = 0.0;
   std::vector<std::int32_t> plastic_links_;  // elasto-plastic links
+  std::vector<std::uint8_t> touched_;        // per node: in a target's or key-point's stencil
+  std::vector<std::int32_t> unseen_;         // the free nodes not touched (this frame)
+  int n_unseen_ = 0;
   std::uint64_t substeps_done_ = 0;          // since construction (plasticity_every counts them)
   SubstepContacts* substep_contacts_ = nullptr;
   ContactSolver contacts_;
@@ -85,6 +90,9 @@ class XpbdSheet final : public SheetModel {
   std::uint64_t detections_ = 0;
 
  public:
+  // Grid cells around a node a seen input touches within which nodes count as seen (the
+  // unseen speed limit, SheetModel::set_unseen_speed_limit).
+  static constexpr int kSeenReach = 0;
   // Extra motion the contact candidates cover, mm (0: found again every frame).
   static constexpr double kContactSkinMm = 8.0;
   // Contact detections since construction (tests, benchmark).

@@ -5,6 +5,8 @@
 //   output tracking_error (latest Figure: mean node distance, mm, per model frame)
 // Parameters:
 //   record   file to write every model frame to as one JSON line (state_recorder.h); default none
+//   record_truth  file to write the truth to, the same way: each new truth state this plugin
+//            reads (once per model frame at most); crease-score pairs the two files offline
 //   label    the figure's name (default "tracking error of sheet_state vs sheet_truth")
 // Run it in the model's loop after the model, so it sees every frame. update is RT-safe: the
 // score is O(nodes); a recorded frame is copied into a bounded queue that a non-RT thread
@@ -39,6 +41,14 @@ class SheetScore final : public Plugin {
         p.fail("record", e.what());
       }
     }
+    if (p.has("record_truth")) {
+      const std::string path = p.get<std::string>("record_truth");
+      try {
+        truth_recorder_ = std::make_unique<sheet_score::StateRecorder>(path, rt::now_ns());
+      } catch (const std::exception& e) {
+        p.fail("record_truth", e.what());
+      }
+    }
     model_ = ports.latest_input<SheetState>("sheet_state");
     truth_ = ports.latest_input<SheetState>("sheet_truth");
     out_ = ports.latest_output<Figure>("tracking_error", figure_);  // safe value: named, no samples
@@ -50,7 +60,10 @@ class SheetScore final : public Plugin {
     if (!m.is_new()) return Status::ok;
     const SheetState& s = model_.value();
     if (recorder_ && !recorder_->record_rt(s) && s.nodes_u != 0) ++dropped_;
-    if (truth_.poll().has_data()) {
+    const rt::ReadInfo t = truth_.poll();
+    if (truth_recorder_ && t.is_new() && !truth_recorder_->record_rt(truth_.value()) && truth_.value().nodes_u != 0)
+      ++dropped_truth_;
+    if (t.has_data()) {
       const double err = sheet_score::mean_node_distance_mm(s, truth_.value());
       if (err >= 0) {
         ++figure_.count;
@@ -64,6 +77,11 @@ class SheetScore final : public Plugin {
   }
 
   void deactivate() override {
+    if (truth_recorder_) {
+      truth_recorder_->stop();
+      log_rt(rt::LogLevel::info, "truth frames recorded", static_cast<std::int64_t>(truth_recorder_->recorded()));
+      if (dropped_truth_ != 0) log_rt(rt::LogLevel::warn, "truth frames not recorded (queue full)", dropped_truth_);
+    }
     if (!recorder_) return;
     recorder_->stop();
     log_rt(rt::LogLevel::info, "model frames recorded", static_cast<std::int64_t>(recorder_->recorded()));
@@ -75,8 +93,8 @@ class SheetScore final : public Plugin {
   LatestInput<SheetState> truth_;
   LatestOutput<Figure> out_;
   Figure figure_{};
-  std::unique_ptr<sheet_score::StateRecorder> recorder_;
-  std::int64_t dropped_ = 0;
+  std::unique_ptr<sheet_score::StateRecorder> recorder_, truth_recorder_;
+  std::int64_t dropped_ = 0, dropped_truth_ = 0;
 };
 }  // namespace
 

@@ -52,10 +52,11 @@ void StateRecorder::run() {
 void StateRecorder::drain() {
   Frame& f = *writing_;
   while (queue_.try_pop(&f)) {
-    char buf[128];
-    std::snprintf(buf, sizeof(buf), "{\"t\":%.6f,\"frame\":%llu,\"grid\":[%u,%u],\"size_mm\":[%.3f,%.3f],\"nodes\":[",
-                  double(f.timestamp_ns - start_ns_) * 1e-9, static_cast<unsigned long long>(f.step), f.nodes_u,
-                  f.nodes_v, f.width_mm, f.height_mm);
+    char buf[192];
+    std::snprintf(buf, sizeof(buf),
+                  "{\"t\":%.6f,\"stamp_ns\":%lld,\"frame\":%llu,\"grid\":[%u,%u],\"size_mm\":[%.3f,%.3f],\"nodes\":[",
+                  double(f.timestamp_ns - start_ns_) * 1e-9, static_cast<long long>(f.timestamp_ns),
+                  static_cast<unsigned long long>(f.step), f.nodes_u, f.nodes_v, f.width_mm, f.height_mm);
     out_ << buf;
     const std::size_t n = static_cast<std::size_t>(f.nodes_u) * f.nodes_v;
     for (std::size_t k = 0; k < n; ++k) {

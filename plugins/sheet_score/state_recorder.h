@@ -1,7 +1,8 @@
 // StateRecorder: writes every sheet state handed to it as one JSON line, on its own non-RT
 // thread, so any run can be scored offline:
-//   {"t":…, "frame":…, "grid":[W,H], "size_mm":[w,h], "nodes":[[x,y,z],…]}
-// t in seconds since the recorder started, node positions in world mm, row by row. The RT side
+//   {"t":…, "stamp_ns":…, "frame":…, "grid":[W,H], "size_mm":[w,h], "nodes":[[x,y,z],…]}
+// t in seconds since the recorder started, stamp_ns the state's own CLOCK_MONOTONIC time
+// (recordings of one run pair by it: recording_score.h), node positions in world mm, row by row. The RT side
 // copies a frame into a bounded queue (record_rt); a frame that finds the queue full is counted
 // as dropped, never written out of order or invented.
 #pragma once

@@ -4,10 +4,10 @@
 // Parameters: fold (half | diagonal | two_folds | unfold), start_s (delay before the fold),
 // repeat (restart after the script ends), origin_x_mm / origin_y_mm / origin_z_mm (world
 // position of sheet point (0,0) when flat; default: the sheet centred on the world origin,
-// where the calibrated cameras look), nodes_u, nodes_v, announce_creases (default true).
-// With announce_creases it also plays the folding sequence's part towards the model: when a
-// fold starts it pushes a crease `add` along the fold line on the `crease` queue (the
-// sequence knows where it folds), and a `clear` when a repeat starts over.
+// where the calibrated cameras look), nodes_u, nodes_v.
+// It tells the tracking model nothing: no crease, no fold line (the robot has no such oracle;
+// only its folding sequence knows the crease it intends, and only roughly). The model holds a
+// fold it was not told of by itself (plugins/sheet_model/README.md, "A fold nobody announced").
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -45,8 +45,6 @@ class SheetTruth final : public Plugin {
     state_->width_mm = static_cast<float>(g.width_mm);
     state_->height_mm = static_cast<float>(g.height_mm);
     out_ = ports.latest_output<SheetState>("sheet_truth", SheetState{});
-    if (p.get<bool>("announce_creases", true)) creases_ = ports.queue_output<SheetCreaseEvent>("crease");
-    announced_.assign(script_.folds().size(), false);
   }
 
   void activate() override { t0_ns_ = -1; }
@@ -56,18 +54,8 @@ class SheetTruth final : public Plugin {
     double t = double(cycle.time_ns - t0_ns_) * 1e-9 - start_s_;
     if (repeat_ && t > script_.duration_s()) {
       const double lap = script_.duration_s() + start_s_;
-      const auto laps = static_cast<std::int64_t>((t + start_s_) / lap);
-      if (laps != laps_) {  // starting over: the sheet is flat again
-        laps_ = laps;
-        std::fill(announced_.begin(), announced_.end(), false);
-        SheetCreaseEvent clear;
-        clear.op = SheetCreaseEvent::Op::clear;
-        clear.timestamp_ns = cycle.time_ns;
-        if (creases_.bound()) (void)creases_.try_push(clear);
-      }
-      t = std::fmod(t + start_s_, lap) - start_s_;
+      t = std::fmod(t + start_s_, lap) - start_s_;  // starting over: the sheet is flat again
     }
-    announce_creases(t < 0 ? 0.0 : t, cycle.time_ns);
     script_.node_positions(t < 0 ? 0.0 : t, nodes_);
     const int W = grid_.nodes_u, H = grid_.nodes_v;
     for (int j = 0; j < H; ++j) {
@@ -95,35 +83,11 @@ class SheetTruth final : public Plugin {
   }
 
  private:
-  // Pushes a crease along each fold line whose fold has begun (theta > 0), once per lap.
-  void announce_creases(double t, std::int64_t now_ns) noexcept {
-    if (!creases_.bound()) return;
-    const auto folds = script_.folds();
-    for (std::size_t f = 0; f < folds.size(); ++f) {
-      if (announced_[f] || folds[f].theta_deg(t) <= 0.0) continue;
-      const sheet::Vec2 a = folds[f].a, b = folds[f].b;
-      const double dx = b.u - a.u, dy = b.v - a.v, len = std::sqrt(dx * dx + dy * dy);
-      if (len <= 0) continue;
-      const double ext = 2.0 * (grid_.width_mm + grid_.height_mm) / len;  // beyond the sheet on both sides
-      SheetCreaseEvent e;
-      e.op = SheetCreaseEvent::Op::add;
-      e.timestamp_ns = now_ns;
-      e.a_mm[0] = float(a.u - ext * dx);
-      e.a_mm[1] = float(a.v - ext * dy);
-      e.b_mm[0] = float(b.u + ext * dx);
-      e.b_mm[1] = float(b.v + ext * dy);
-      announced_[f] = creases_.try_push(e);
-    }
-  }
-
   sheet::GridParams grid_;
   sheet::FoldScript script_ = sheet::FoldScript::half_fold(sheet::GridParams{});
   std::vector<sheet::Vec3> nodes_;
   std::unique_ptr<SheetState> state_;
   LatestOutput<SheetState> out_;
-  QueueOutput<SheetCreaseEvent> creases_;
-  std::vector<bool> announced_;  // per fold, this lap (sized at configure)
-  std::int64_t laps_ = 0;
   double start_s_ = 1.0;
   bool repeat_ = false;
   std::int64_t t0_ns_ = -1;

@@ -30,6 +30,7 @@ namespace crease::world {
   p.solver.yield_strain = 0.05;
   p.solver.plasticity_rate = 0.95;
   p.solver.plasticity_every = 20;        // every 10 ms
+  p.solver.crease_strain = 0.0;          // the tracking model's guess at a crease; the world's is physics
   return p;
 }
 

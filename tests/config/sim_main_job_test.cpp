@@ -1,12 +1,14 @@
 // The main job end to end: creased runs config/sim.yaml (the simulated world with its devices
 // and the drivers, the world's sheet as truth, five rendered cameras, detection, triangulation,
 // the sheet model), prints the tracking error against the truth, and records every model frame
-// as JSON lines. The world's sheet lies on the table at the pose its seed drew (seed 1: 15 mm
+// and the truth as JSON lines (--record-state, --record-truth), which crease-score scores
+// offline to the figure creased printed. The world's sheet lies on the table at the pose its seed drew (seed 1: 15 mm
 // off and turned 14 deg from where the model starts), so the model must find it and hold it.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,11 +22,11 @@ namespace fs = std::filesystem;
 TEST_CASE("config/sim.yaml tracks the world's sheet and records every model frame") {
   char tmpl[] = "/tmp/crease-main-XXXXXX";
   const fs::path dir = mkdtemp(tmpl);
-  const fs::path record = dir / "state.jsonl";
+  const fs::path record = dir / "state.jsonl", truth = dir / "truth.jsonl";
   const std::string cmd = std::string(CREASE_BIN_DIR) + "/creased --config " CREASE_SOURCE_DIR "/config/sim.yaml" +
                           " --plugin-dir " CREASE_PLUGIN_DIR " --socket " + (dir / "s.sock").string() +
                           " --report-dir " + (dir / "reports").string() + " --duration 12 --log-level warn" +
-                          " --set score.record=" + record.string() + " 2>&1";
+                          " --record-state " + record.string() + " --record-truth " + truth.string() + " 2>&1";
   FILE* f = popen(cmd.c_str(), "r");
   REQUIRE(f != nullptr);
   std::string out;
@@ -76,5 +78,20 @@ TEST_CASE("config/sim.yaml tracks the world's sheet and records every model fram
   CHECK(shaped);
   CHECK(in_order);
   CHECK(fs::exists(dir / "reports" / "report.html"));
+
+  // Scored offline from the two recordings, paired by stamp: the figure creased printed (which
+  // took the newest truth at each model frame; offline the truth is linear between frames).
+  FILE* s = popen((std::string(CREASE_BIN_DIR) + "/crease-score " + record.string() + " --truth " + truth.string() +
+                   " 2>&1").c_str(), "r");
+  REQUIRE(s != nullptr);
+  std::string scored;
+  while (std::fgets(buf, sizeof(buf), s) != nullptr) scored += buf;
+  const int src = pclose(s);
+  INFO(scored);
+  REQUIRE(WIFEXITED(src));
+  CHECK(WEXITSTATUS(src) == 0);
+  REQUIRE(std::regex_search(scored, m, std::regex("score: frames=([0-9]+) skipped=[0-9]+ mean_mm=([0-9.]+)")));
+  CHECK(std::stoi(m[1]) > frames - 10);
+  CHECK(std::fabs(std::stod(m[2]) - mean_mm) < 0.05 * mean_mm + 0.2);
   fs::remove_all(dir);
 }

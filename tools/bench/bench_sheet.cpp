@@ -5,7 +5,11 @@
 //
 // Tracking: 35 markers x 5 key-points observed at 15 Hz with 0.3 mm noise (fixed seed);
 // runs: all key-points; 30 % dropped per vision frame plus the flap (v < h/2) hidden for
-// 1 s. Error: mean distance of every node to the analytic fold, every frame.
+// 1 s. Error: mean distance of every node to the analytic fold, every frame. Nobody tells the
+// engines where the sheet folds (no crease on the fold line; --announce puts it back, on
+// Bullet's links too, as this bench did before issue 15); --elastic runs our and the ODE
+// backend's links without plasticity, --old-predictor the key-point prediction before issue 15
+// (constant velocity for 1.5 s, unbounded).
 // Time: ours (springs), Bullet and ours (keypoints) take --repeats turns each (default 5), in turn. In a turn an
 // engine tracks the fold from a fresh start again and again until it has stepped for at least
 // --turn-s seconds (default 0.5: one Bullet run, ~10 of ours), so both are timed over windows
@@ -56,11 +60,13 @@ struct TrackResult {
   int frames = 0;
 };
 
+PredictorParams g_predictor;  // the prediction every engine's key-points go through
+
 TrackResult track(Engine& e, const FoldScript& truth, const std::vector<Vec2>& kps, bool dropout, int node_count) {
   std::mt19937 rng(20261121);
   std::normal_distribution<double> noise(0.0, 0.3);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
-  KeypointPredictor pred(static_cast<int>(kps.size()));
+  KeypointPredictor pred(static_cast<int>(kps.size()), g_predictor);
   std::vector<TargetPoint> targets(kps.size());
   std::vector<Vec3> x(node_count), prev, gt(node_count);
   e.positions(prev);
@@ -101,7 +107,9 @@ TrackResult track(Engine& e, const FoldScript& truth, const std::vector<Vec2>& k
   return r;
 }
 
-// A Crease sheet on the table with a crease on the fold line, key-points set every frame, one
+bool g_announce = false;  // a crease on the fold line, for the engines that take one
+
+// A Crease sheet on the table (with --announce a crease on the fold line), key-points set every frame, one
 // step_rt per 1/60 s frame. Ours: XPBD, seed 000 topology, self-collision (XpbdSheet); the ODE
 // backend: the same model from ODE bodies and soft distance joints (OdeSheet). The key-points
 // pull it as SheetRunner does with p.solver.coupling: zero-length springs (seed 001 Eq. 4,
@@ -116,7 +124,7 @@ struct CreaseEngine {
     world.add_table(0.0);
     s = std::make_unique<Sheet>(p);
     s->set_collision_world(&world);
-    s->add_crease({{0, p.grid.height_mm / 2}, {p.grid.width_mm, p.grid.height_mm / 2}});
+    if (g_announce) s->add_crease({{0, p.grid.height_mm / 2}, {p.grid.width_mm, p.grid.height_mm / 2}});
     obs.reserve(SheetModel::kMaxKeypoints);
   }
   Engine engine() {
@@ -137,7 +145,7 @@ using Ours = CreaseEngine<XpbdSheet>;
 using OdeEngine = CreaseEngine<OdeSheet>;
 
 // Bullet 3.24 soft body with the same nodes, links and masses, in metres; ICL's settings:
-// linear stiffness 0.9 (0.001 across the crease), as many position iterations as our
+// linear stiffness 0.9 (0.001 across the crease with --announce), as many position iterations as our
 // substeps (10: one link pass each), one 1/60 s step,
 // key-point coupling by node velocities lambda (k - c) (seed 000 Eq. 3) once per frame.
 struct BulletSheet {
@@ -183,7 +191,7 @@ struct BulletSheet {
     const Grid& g = ref.grid();
     for (int k = 0; k < ref.link_count(); ++k) {
       const int a = ref.topology().a[k], b = ref.topology().b[k];
-      const bool cut = segments_cross(g.sheet_of(a), g.sheet_of(b), crease.a, crease.b);
+      const bool cut = g_announce && segments_cross(g.sheet_of(a), g.sheet_of(b), crease.a, crease.b);
       sb->appendLink(a, b, cut ? soft : stiff);
     }
     sb->m_cfg.piterations = p.solver.substeps;  // our link passes per frame
@@ -258,9 +266,19 @@ int run_sheet(int argc, char** argv) {
       p.solver.substeps = std::atoi(argv[++i]);
     } else if (a == "--no-self-collision") {
       p.solver.self_collision = false;
+    } else if (a == "--announce") {
+      g_announce = true;
+    } else if (a == "--elastic") {
+      p.solver.plasticity_rate = 0;
+      p.solver.yield_strain = 0;
+      p.solver.crease_strain = 0;
+    } else if (a == "--old-predictor") {
+      g_predictor.max_extrapolate_s = 1.5;
+      g_predictor.bound_by_sheet = false;
     } else {
       std::fprintf(stderr,
-                   "usage: crease-bench sheet [--repeats N] [--turn-s S] [--substeps N] [--no-self-collision]\n");
+                   "usage: crease-bench sheet [--repeats N] [--turn-s S] [--substeps N] [--no-self-collision]\n"
+                   "       [--announce] [--elastic] [--old-predictor]\n");
       return 2;
     }
   }
@@ -317,6 +335,11 @@ int run_sheet(int argc, char** argv) {
               p.grid.nodes_u, p.grid.nodes_v, ours.s->link_count(), ours.s->topology().structural_count,
               ours.s->topology().bending_count, p.solver.substeps);
   std::printf("half fold 0->175 deg in 5 s, hold 3 s; %zu key-points at 15 Hz, 0.3 mm noise\n", kps.size());
+  std::printf("fold line %s; links %s; prediction %.2f s %s\n", g_announce ? "announced (a crease)" : "not announced",
+              p.solver.plasticity_rate > 0 ? "elasto-plastic" : "elastic", g_predictor.max_extrapolate_s,
+              g_predictor.bound_by_sheet ? "bounded by the sheet" : "unbounded");
+  std::printf("ours: yield strain %.3f, plasticity rate %.2f, crease_strain %.2f\n", p.solver.yield_strain,
+              p.solver.plasticity_rate, p.solver.crease_strain);
   std::printf("coupling: springs (seed 001 Eq. 4, %.0e m/N) or keypoints (seed 000 Eqs. 1-4, lambda %.1f/s)\n",
               p.solver.target_compliance_m_per_n, pk.solver.keypoint_gain_per_s);
   auto runs = [](const char* name, const std::vector<double>& us, const std::vector<int>& n) {

@@ -121,7 +121,7 @@ TEST_CASE("a run recorded with record: and replayed 2000 s later reaches the mod
   {
     Host h;
     h.host.add_loop({"vision", 15.0, 0, -1});
-    h.add("truth", "sheet_truth", "vision", 1, "{start_s: 0.3, announce_creases: false}");
+    h.add("truth", "sheet_truth", "vision", 1, "{start_s: 0.3}");
     h.add("cameras", "camera_sim", "vision", 5,
           "{cameras: cameras, layout: markers/layout.yaml, noise: 1.0, record: '" + rec.string() + "'}");
     auto st = std::make_unique<crease::SheetState>();

@@ -90,8 +90,7 @@ TEST_CASE("camera_sim renders the sheet_truth plugin's sheet where that plugin p
   for (int k = 0; k < 2; ++k) {
     Fixture fx;
     fx.add("truth", "sheet_truth", 1,
-           "{start_s: 1000, announce_creases: false, origin_x_mm: " + std::to_string(origin_x[k]) +
-               "}");
+           "{start_s: 1000, origin_x_mm: " + std::to_string(origin_x[k]) + "}");
     fx.add_cameras_and_vision();
     fx.host.start();
     x[k] = fx.mean_x();

@@ -287,6 +287,95 @@ TEST_CASE("absurd but finite targets are bounded by the speed limit") {
   CHECK(state->all_finite());
 }
 
+// The half fold (0 -> 175 deg in 5 s, hold 3 s) seen at 15 Hz, the flap's key-points only while
+// the fold angle is at most hide_above_deg (90: a sheet printed on its front only, whose flap
+// shows its blank back past 90 deg). No crease is announced. The end error is the mean node
+// distance to the truth after the hold; speeds are each node's move over a 1/60 s frame (the
+// fold's own fastest: its far edge, 148.5 mm x 35 deg/s); the model's fastest is taken while the
+// flap is out of sight (from the first vision frame without it).
+namespace {
+struct HiddenFlapRun {
+  double end_err_mm = 0, max_speed_mm_s = 0, truth_speed_mm_s = 0, flap_top_mm = 0;
+  bool hidden = false;
+};
+HiddenFlapRun hidden_flap(const SheetParams& p, double hide_above_deg) {
+  SheetRunner r(p);  // the table at z = 0
+  auto state = std::make_unique<crease::SheetState>();
+  auto kp = std::make_unique<crease::Keypoints>();
+  const FoldScript fold = FoldScript::half_fold(p.grid);
+  const auto& kps = kps_layout();
+  const int n = r.model().node_count();
+  std::vector<Vec3> gt(n), gt_prev(n), prev(r.model().positions().begin(), r.model().positions().end());
+  fold.node_positions(0.0, gt_prev);
+  HiddenFlapRun out;
+  const auto ns = [](double t) { return static_cast<std::int64_t>(1e9 + t * 1e9); };
+  const int frames = static_cast<int>(fold.duration_s() * 60 + 0.5);
+  for (int f = 0; f < frames; ++f) {
+    const double t = f / 60.0;
+    if (f % 4 == 0) {  // 15 Hz
+      const bool flap_away = fold.folds()[0].theta_deg(t) > hide_above_deg;
+      out.hidden = out.hidden || flap_away;
+      kp->timestamp_ns = ns(t);
+      kp->count = 0;
+      for (std::size_t i = 0; i < kps.size(); ++i) {
+        if (flap_away && kps[i].v < 148.5) continue;
+        const Vec3 w = fold.position(kps[i], t);
+        kp->points[kp->count++] = {{float(w.x), float(w.y), float(w.z)}, {float(kps[i].u), float(kps[i].v)}, 0.1f,
+                                   static_cast<std::uint16_t>(i / 5), static_cast<std::uint8_t>(i % 5), 0, 3};
+      }
+      r.observe_keypoints(*kp);
+    }
+    REQUIRE(r.step_rt(1.0 / 60, ns(t + 1.0 / 60), *state));
+    fold.node_positions(t + 1.0 / 60, gt);
+    const auto x = r.model().positions();
+    double err = 0;
+    for (int i = 0; i < n; ++i) {
+      err += norm(x[i] - gt[i]);
+      if (out.hidden) out.max_speed_mm_s = std::max(out.max_speed_mm_s, norm(x[i] - prev[i]) * 60.0);
+      out.truth_speed_mm_s = std::max(out.truth_speed_mm_s, norm(gt[i] - gt_prev[i]) * 60.0);
+      out.flap_top_mm = std::max(out.flap_top_mm, x[i].z);
+      prev[i] = x[i];
+      gt_prev[i] = gt[i];
+    }
+    out.end_err_mm = err / n;
+  }
+  CHECK(state->all_finite());
+  return out;
+}
+}  // namespace
+
+TEST_CASE("a fold nobody announced holds when its flap goes out of sight") {
+  // The flap seen until the fold is complete (175 deg), then hidden for the 3 s hold.
+  const HiddenFlapRun held = hidden_flap(SheetParams{}, 174.9);
+  SheetParams elastic;  // the failing variant: links without plasticity
+  elastic.solver.plasticity_rate = 0;
+  elastic.solver.yield_strain = 0;
+  const HiddenFlapRun sprung = hidden_flap(elastic, 174.9);
+  MESSAGE("elasto-plastic links: end error " << held.end_err_mm << " mm; elastic: " << sprung.end_err_mm << " mm");
+  CHECK(held.end_err_mm <= 5.0);
+  CHECK(sprung.end_err_mm > 20.0);
+}
+
+TEST_CASE("a flap that turns its markers away past 90 deg is held by the model, not flung") {
+  const HiddenFlapRun held = hidden_flap(SheetParams{}, 90.0);
+  SheetParams before;  // the failing variant: the prediction before (constant velocity for 1.5 s, unbounded)
+  before.predictor.max_extrapolate_s = 1.5;
+  before.predictor.bound_by_sheet = false;
+  before.predictor.unseen_speed_memory_s = 0;
+  const HiddenFlapRun flung = hidden_flap(before, 90.0);
+  MESSAGE("bounded, short prediction: end error " << held.end_err_mm << " mm, fastest hidden node " << held.max_speed_mm_s
+                                                  << " mm/s (the fold's " << held.truth_speed_mm_s
+                                                  << "), highest node " << held.flap_top_mm << " mm");
+  MESSAGE("constant velocity for 1.5 s: end error " << flung.end_err_mm << " mm, fastest hidden node "
+                                                    << flung.max_speed_mm_s << " mm/s, highest node "
+                                                    << flung.flap_top_mm << " mm");
+  CHECK(held.end_err_mm <= 10.0);
+  CHECK(held.max_speed_mm_s <= held.truth_speed_mm_s);
+  CHECK(held.flap_top_mm <= 148.5 + 5.0);  // never higher than the flap is long
+  // The failing variant: the old prediction flings the flap.
+  CHECK((flung.end_err_mm > 10.0 || flung.max_speed_mm_s > flung.truth_speed_mm_s));
+}
+
 TEST_CASE("the runner's step allocates nothing") {
   SheetParams p;
   SUBCASE("springs") { p.solver.coupling = Coupling::springs; }

@@ -79,7 +79,7 @@ struct Fixture {
   }
   // The sheet camera_sim renders: the sheet_truth plugin's, on the `sheet_truth` port.
   void add_truth(const std::string& more = "") {
-    add("truth", "sheet_truth", 1, "{announce_creases: false" + more + "}");
+    add("truth", "sheet_truth", 1, "{nodes_u: 15" + more + "}");
   }
   void add_vision(const std::string& cameras_dir, const std::string& channel,
                   const std::string& more = "") {
