@@ -1,6 +1,7 @@
 // Plugin `sheet_model` (model loop, 60 Hz by default): the sheet model of seed 000/001 kept
 // on the observed sheet.
 //   in:  keypoints (latest, Keypoints), target_points (latest, TargetPoints),
+//        depth_targets (latest, DepthTargets: the depth path's point-to-plane springs),
 //        crease (queue, SheetCreaseEvent), memorize (queue, SheetMemorizeEvent),
 //        reset (queue, SheetResetEvent)
 //   out: sheet_state (latest, SheetState)
@@ -13,11 +14,15 @@
 // springs of compliance target_compliance_m_per_n; or `keypoints`, seed 000's node-velocity
 // P-controller of gain keypoint_gain_per_s), keypoint_gain_per_s, target_compliance_m_per_n,
 // compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
-// self_collision (0/1), self_collision_every (1..100 substeps; the last substep always).
+// self_collision (0/1), self_collision_every (1..100 substeps; the last substep always),
+// depth_compliance_m_per_n (a depth target of weight 1), depth_along_normal (default true: depth
+// targets pull along the model's normal only; false: 3-D springs).
+
 #include <memory>
 #include <string>
 
 #include "core/plugin.h"
+#include "core/port_types/depth_targets.h"
 #include "core/port_types/keypoints.h"
 #include "core/port_types/sheet_state.h"
 #include "plugins/sheet_model/sheet_runner.h"
@@ -47,6 +52,8 @@ class SheetModelPlugin final : public Plugin {
       p.fail("coupling", "must be springs or keypoints, not '" + coupling + "'");
     sp.solver.keypoint_gain_per_s = p.get_in_range<double>("keypoint_gain_per_s", 10.0, 0.0, 1e6);
     sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);
+    sp.solver.depth_compliance_m_per_n = p.get_in_range<double>("depth_compliance_m_per_n", 0.05, 0.0, 1e6);
+    sp.solver.depth_along_normal = p.get<bool>("depth_along_normal", true);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
     sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
     sp.solver.yield_strain = p.get_in_range<double>("yield_strain", 0.0, 0.0, 1.0);
@@ -59,6 +66,7 @@ class SheetModelPlugin final : public Plugin {
     state_ = std::make_unique<SheetState>();
     keypoints_ = ports.latest_input<Keypoints>("keypoints");
     targets_ = ports.latest_input<TargetPoints>("target_points");
+    depth_ = ports.latest_input<DepthTargets>("depth_targets");
     crease_ = ports.queue_input<SheetCreaseEvent>("crease");
     memorize_ = ports.queue_input<SheetMemorizeEvent>("memorize");
     reset_ = ports.queue_input<SheetResetEvent>("reset");
@@ -68,6 +76,7 @@ class SheetModelPlugin final : public Plugin {
   Status update(const Cycle& cycle) override {
     if (keypoints_.bound() && keypoints_.poll().is_new()) runner_->observe_keypoints(keypoints_.value());
     if (targets_.bound() && targets_.poll().is_new()) runner_->set_targets(targets_.value());
+    if (depth_.bound() && depth_.poll().is_new()) runner_->set_depth_targets(depth_.value());
     SheetResetEvent r;
     while (reset_.bound() && reset_.try_pop(r)) runner_->apply(r);
     SheetCreaseEvent c;
@@ -87,6 +96,7 @@ class SheetModelPlugin final : public Plugin {
   std::unique_ptr<SheetState> state_;
   LatestInput<Keypoints> keypoints_;
   LatestInput<TargetPoints> targets_;
+  LatestInput<DepthTargets> depth_;
   QueueInput<SheetCreaseEvent> crease_;
   QueueInput<SheetMemorizeEvent> memorize_;
   QueueInput<SheetResetEvent> reset_;

@@ -75,6 +75,11 @@ struct SolverParams {
   double keypoint_gain_per_s = 10.0;
   // Zero-length target springs (seed 001 Eq. 4): alpha_input, m/N.
   double target_compliance_m_per_n = 1e-6;
+  // Depth targets (SheetModel::set_normal_targets): alpha of a target of weight 1, m/N (a
+  // target of weight w has alpha / w); along_normal: the spring acts along the model's normal at
+  // its sheet point only (point-to-plane), else in 3-D like a target point.
+  double depth_compliance_m_per_n = 0.05;
+  bool depth_along_normal = true;
   // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
   double friction = 0.5;
   bool self_collision = true;

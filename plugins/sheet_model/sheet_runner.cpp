@@ -21,6 +21,7 @@ SheetRunner::SheetRunner(std::unique_ptr<SheetModel> model, double table_height_
   predicted_.resize(SheetModel::kMaxTargets);
   keypoint_obs_.resize(SheetModel::kMaxKeypoints);
   external_.resize(TargetPoints::kCapacity);
+  depth_.resize(DepthTargets::kCapacity);
   last_good_.assign(model_->positions().begin(), model_->positions().end());
   normals_.resize(model_->node_count());
   strain_.resize(model_->link_count());
@@ -46,6 +47,16 @@ void SheetRunner::set_targets(const TargetPoints& t) noexcept {
   for (std::uint32_t i = 0; i < n; ++i) {
     const auto& p = t.points[i];
     external_[n_external_++] = {{p.world_mm[0], p.world_mm[1], p.world_mm[2]}, {p.sheet_mm[0], p.sheet_mm[1]}};
+  }
+}
+
+void SheetRunner::set_depth_targets(const DepthTargets& t) noexcept {
+  n_depth_ = 0;
+  depth_stamp_ns_ = t.timestamp_ns;
+  const std::uint32_t n = std::min(t.count, DepthTargets::kCapacity);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const auto& p = t.points[i];
+    depth_[n_depth_++] = {{p.world_mm[0], p.world_mm[1], p.world_mm[2]}, {p.sheet_mm[0], p.sheet_mm[1]}, p.weight};
   }
 }
 
@@ -76,6 +87,7 @@ void SheetRunner::apply(const SheetResetEvent&) noexcept {
   model_->reset_rt();
   predictor_.clear();
   n_external_ = 0;
+  n_depth_ = 0;
   last_good_.assign(model_->positions().begin(), model_->positions().end());
 }
 
@@ -97,6 +109,9 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
   } else {
     model_->set_targets(all);
   }
+  const bool depth_fresh = n_depth_ > 0 && static_cast<double>(now_ns - depth_stamp_ns_) * 1e-9 <= kDepthMaxAgeS;
+  depth_used_ = model_->set_normal_targets(
+      std::span<const NormalTarget>(depth_.data(), depth_fresh ? static_cast<std::size_t>(n_depth_) : 0));
   model_->save_links_rt();  // with last_good_: the state this step starts from
   model_->step_rt(dt_s);
   ++steps_;

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/port_types/depth_targets.h"
 #include "core/port_types/keypoints.h"
 #include "core/port_types/sheet_state.h"
 #include "collision_world.h"
@@ -32,6 +33,11 @@ class SheetRunner {
   // Inputs (RT). Times are CLOCK_MONOTONIC ns.
   void observe_keypoints(const Keypoints& k) noexcept;
   void set_targets(const TargetPoints& t) noexcept;
+  // The depth path's targets (point-to-plane springs, SheetModel::set_normal_targets), used by
+  // every step until replaced or until they are kDepthMaxAgeS older than the step.
+  void set_depth_targets(const DepthTargets& t) noexcept;
+  static constexpr double kDepthMaxAgeS = 1.5;
+  [[nodiscard]] int depth_targets_used() const noexcept { return depth_used_; }
   void apply(const SheetCreaseEvent& e) noexcept;
   void apply(const SheetMemorizeEvent& e) noexcept;
   void apply(const SheetResetEvent& e) noexcept;
@@ -58,6 +64,10 @@ class SheetRunner {
   std::vector<KeypointObs> keypoint_obs_;  // the predicted key-points for set_keypoints
   std::vector<TargetPoint> external_;
   int n_external_ = 0;
+  std::vector<NormalTarget> depth_;  // capacity DepthTargets::kCapacity
+  int n_depth_ = 0;
+  std::int64_t depth_stamp_ns_ = 0;
+  int depth_used_ = 0;
   std::vector<Vec3> last_good_, normals_;
   std::vector<double> strain_;
   std::int64_t epoch_ns_ = 0;
