@@ -16,7 +16,8 @@
 // compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
 // self_collision (0/1), self_collision_every (1..100 substeps; the last substep always),
 // depth_compliance_m_per_n (a depth target of weight 1), depth_along_normal (default true: depth
-// targets pull along the model's normal only; false: 3-D springs).
+// targets pull along the model's normal only; false: 3-D springs), depth_predict (default true:
+// a depth target moves on at its node's velocity between the last two depth frames).
 
 #include <memory>
 #include <string>
@@ -63,6 +64,7 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.self_collision_every = p.get_in_range<int>("self_collision_every", 2, 1, 100);
     const double table = p.get_in_range<double>("table_height_mm", 0.0, -1e4, 1e4);
     runner_ = std::make_unique<sheet::SheetRunner>(sp, table);
+    runner_->set_depth_prediction(p.get<bool>("depth_predict", true));
     state_ = std::make_unique<SheetState>();
     keypoints_ = ports.latest_input<Keypoints>("keypoints");
     targets_ = ports.latest_input<TargetPoints>("target_points");

@@ -34,9 +34,15 @@ class SheetRunner {
   void observe_keypoints(const Keypoints& k) noexcept;
   void set_targets(const TargetPoints& t) noexcept;
   // The depth path's targets (point-to-plane springs, SheetModel::set_normal_targets), used by
-  // every step until replaced or until they are kDepthMaxAgeS older than the step.
+  // every step until replaced or until they are kDepthMaxAgeS older than the step. A target on a
+  // grid node that also had one in the previous set (at most kDepthMaxGapS before) moves on at
+  // the velocity between the two, for at most kDepthMaxPredictS (depth frames come at a few Hz
+  // to 30 Hz; the model steps at 60 Hz), unless set_depth_prediction(false).
   void set_depth_targets(const DepthTargets& t) noexcept;
+  void set_depth_prediction(bool on) noexcept { depth_predict_ = on; }
   static constexpr double kDepthMaxAgeS = 1.5;
+  static constexpr double kDepthMaxGapS = 0.5;
+  static constexpr double kDepthMaxPredictS = 0.5;
   [[nodiscard]] int depth_targets_used() const noexcept { return depth_used_; }
   void apply(const SheetCreaseEvent& e) noexcept;
   void apply(const SheetMemorizeEvent& e) noexcept;
@@ -65,6 +71,11 @@ class SheetRunner {
   std::vector<TargetPoint> external_;
   int n_external_ = 0;
   std::vector<NormalTarget> depth_;  // capacity DepthTargets::kCapacity
+  std::vector<NormalTarget> depth_used_targets_;  // depth_ predicted to the step's time
+  std::vector<std::int32_t> depth_node_;          // per target: its grid node, -1: none
+  std::vector<Vec3> node_last_, node_vel_;         // per node: last depth target, its velocity
+  std::vector<std::int64_t> node_last_ns_;         // per node: when (INT64_MIN: never)
+  bool depth_predict_ = true;
   int n_depth_ = 0;
   std::int64_t depth_stamp_ns_ = 0;
   int depth_used_ = 0;

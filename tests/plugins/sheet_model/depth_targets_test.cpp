@@ -69,3 +69,55 @@ TEST_CASE("depth targets older than the horizon are dropped: the sheet falls") {
   MESSAGE("stale targets: up " << old.up_mm << " mm");
   CHECK(old.up_mm < -100.0);  // a second of free fall: ~ -4.9 m with no table (damped and capped)
 }
+
+// Targets rising at 100 mm/s, one set every 0.2 s (a depth path at 5 Hz), the model at 60 Hz:
+// with the prediction the model keeps up between sets; without it, it waits for the next set
+// (half a set's rise behind on average).
+double rising_lag(bool predict) {
+  SheetParams p;
+  p.solver.self_collision = false;
+  SheetRunner r(p, -1e9);
+  r.set_depth_prediction(predict);
+  auto st = std::make_unique<crease::SheetState>();
+  const auto flat = std::vector<Vec3>(r.model().positions().begin(), r.model().positions().end());
+  auto t = std::make_unique<crease::DepthTargets>();
+  const int W = p.grid.nodes_u, H = p.grid.nodes_v;
+  constexpr double kSpeed = 100.0;  // mm/s
+  const std::int64_t t0 = 5'000'000'000;
+  double lag = 0;
+  int samples = 0;
+  for (int k = 0; k < 120; ++k) {  // 2 s at 60 Hz
+    const std::int64_t now = t0 + k * 16'666'667;
+    if (k % 12 == 0) {  // a new set every 0.2 s, of the sheet's height then
+      t->count = 0;
+      t->timestamp_ns = now;
+      for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+          auto& q = t->points[t->count++];
+          const Vec3 x = flat[static_cast<std::size_t>(j * W + i)];
+          q.world_mm[0] = float(x.x);
+          q.world_mm[1] = float(x.y);
+          q.world_mm[2] = float(x.z + kSpeed * double(now - t0) * 1e-9);
+          q.sheet_mm[0] = float(i * p.grid.width_mm / (W - 1));
+          q.sheet_mm[1] = float(j * p.grid.height_mm / (H - 1));
+          q.weight = 1.0f;
+        }
+      r.set_depth_targets(*t);
+    }
+    (void)r.step_rt(1.0 / 60, now, *st);
+    if (k < 30) continue;  // after two sets: a velocity
+    double z = 0;
+    for (std::size_t i = 0; i < flat.size(); ++i) z += (r.model().positions()[i].z - flat[i].z) / flat.size();
+    lag += kSpeed * double(now - t0) * 1e-9 - z;
+    ++samples;
+  }
+  return lag / samples;
+}
+
+TEST_CASE("between depth sets a target moves on at its node's velocity; without the prediction the model lags") {
+  const double with = rising_lag(true), without = rising_lag(false);
+  MESSAGE("mean lag behind a sheet rising at 100 mm/s, sets at 5 Hz: " << with << " mm predicted, " << without
+                                                                      << " mm held");
+  CHECK(std::abs(with) < 2.0);
+  CHECK(without > 7.0);  // ~ half of the 20 mm a set period rises
+}
