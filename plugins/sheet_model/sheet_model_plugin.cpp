@@ -16,8 +16,9 @@
 // compliance_bending_m_per_n, damping_per_s, yield_strain, plasticity_rate, table_height_mm,
 // self_collision (0/1), self_collision_every (1..100 substeps; the last substep always),
 // depth_compliance_m_per_n (a depth target of weight 1), depth_along_normal (default true: depth
-// targets pull along the model's normal only; false: 3-D springs), depth_predict (default true:
-// a depth target moves on at its node's velocity between the last two depth frames).
+// targets pull along the model's normal only; false: 3-D springs), depth_predict (default false:
+// a depth target moves on at its node's velocity between the last two depth frames),
+// depth_tangential_weight (0.3: the share of the tangential error a depth target corrects).
 
 #include <memory>
 #include <string>
@@ -55,6 +56,7 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);
     sp.solver.depth_compliance_m_per_n = p.get_in_range<double>("depth_compliance_m_per_n", 0.05, 0.0, 1e6);
     sp.solver.depth_along_normal = p.get<bool>("depth_along_normal", true);
+    sp.solver.depth_tangential_weight = p.get_in_range<double>("depth_tangential_weight", 0.3, 0.0, 1.0);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
     sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
     sp.solver.yield_strain = p.get_in_range<double>("yield_strain", 0.0, 0.0, 1.0);
@@ -64,7 +66,7 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.self_collision_every = p.get_in_range<int>("self_collision_every", 2, 1, 100);
     const double table = p.get_in_range<double>("table_height_mm", 0.0, -1e4, 1e4);
     runner_ = std::make_unique<sheet::SheetRunner>(sp, table);
-    runner_->set_depth_prediction(p.get<bool>("depth_predict", true));
+    runner_->set_depth_prediction(p.get<bool>("depth_predict", false));
     state_ = std::make_unique<SheetState>();
     keypoints_ = ports.latest_input<Keypoints>("keypoints");
     targets_ = ports.latest_input<TargetPoints>("target_points");

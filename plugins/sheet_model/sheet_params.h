@@ -80,6 +80,10 @@ struct SolverParams {
   // its sheet point only (point-to-plane), else in 3-D like a target point.
   double depth_compliance_m_per_n = 0.05;
   bool depth_along_normal = true;
+  // With depth_along_normal: the share of the tangential error the spring corrects too (0: the
+  // normal only; 1: a 3-D spring). Depth says little about where along the surface a point lies,
+  // but not nothing (the sheet's edges): without any of it the sheet slides as the flap turns.
+  double depth_tangential_weight = 0.3;
   // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
   double friction = 0.5;
   bool self_collision = true;

@@ -151,9 +151,10 @@ void XpbdSheet::project_targets() noexcept {
 }
 
 // Depth targets: seed 001 Eq. 4 on the sheet point c = sum b_e x_e, projected on the model's
-// unit normal n there (taken at the frame's start): C = n . (c - x_d),
-// x_e -= w_e b_e n C / (sum w_e b_e^2 + alpha / (weight dt_s^2)). Without depth_along_normal,
-// the 3-D spring of project_targets with that compliance.
+// unit normal n there (taken at the frame's start): with d = c - x_d split into its normal part
+// n (n . d) and the rest, x_e -= w_e b_e (n (n . d) + t (d - n (n . d))) / (sum w_e b_e^2 +
+// alpha / (weight dt_s^2)), t = depth_tangential_weight. Without depth_along_normal, the 3-D
+// spring of project_targets with that compliance.
 void XpbdSheet::prepare_normal_targets(double dt_s) noexcept {
   if (n_normal_targets_ == 0) return;
   const bool along = params_.solver.depth_along_normal;
@@ -181,12 +182,14 @@ void XpbdSheet::prepare_normal_targets(double dt_s) noexcept {
 void XpbdSheet::project_normal_targets() noexcept {
   Vec3* x = x_.data();
   const bool along = params_.solver.depth_along_normal;
+  const double tw = params_.solver.depth_tangential_weight;
   for (int t = 0; t < n_normal_targets_; ++t) {
     const NormalRow& r = normal_rows_[t];
     if (!(r.inv_den > 0)) continue;
     const Vec3 c = r.b[0] * x[r.node[0]] + r.b[1] * x[r.node[1]] + r.b[2] * x[r.node[2]] + r.b[3] * x[r.node[3]];
     const Vec3 d = c - r.world;
-    const Vec3 err = along ? (r.inv_den * dot(r.normal, d)) * r.normal : r.inv_den * d;
+    const Vec3 dn = dot(r.normal, d) * r.normal;
+    const Vec3 err = along ? r.inv_den * (dn + tw * (d - dn)) : r.inv_den * d;
     for (int e = 0; e < 4; ++e) x[r.node[e]] -= r.wb[e] * err;
   }
 }

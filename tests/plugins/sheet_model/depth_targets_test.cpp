@@ -22,6 +22,7 @@ struct Moved {
 Moved pull(bool along_normal, std::int64_t target_age_ns = 0) {
   SheetParams p;
   p.solver.depth_along_normal = along_normal;
+  p.solver.depth_tangential_weight = 0.0;  // the normal only
   p.solver.self_collision = false;
   SheetRunner r(p, -1e9);  // table far below: gravity only
   auto st = std::make_unique<crease::SheetState>();
