@@ -27,7 +27,7 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
   // The plugin bound the channel with these cameras (plugins/camera_rig/images_port.h): the
   // registry checked them.
   CREASE_DEMAND(channel_->cameras() == source_->channel_images(),
-                "the frame channel does not have this source's images");
+                "the frame channel does not have this source's cameras");
   if (!record_dir.empty()) recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras());
   writer_ = channel_->try_claim_writer();  // now if free, so the first request need not wait
   thread_ = std::thread([this] { run(); });
