@@ -12,7 +12,8 @@ std::string describe(const std::string& type, std::uint32_t version, std::size_t
 }
 
 std::string describe(const frames::CameraSpec& c) {
-  return "'" + c.name + "' " + std::to_string(c.width) + "x" + std::to_string(c.height);
+  return "'" + c.name + "' " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+         (c.bytes_per_pixel == 1 ? "" : "x" + std::to_string(c.bytes_per_pixel) + " bytes");
 }
 
 const char* role_of(bool writer) { return writer ? "writes" : "reads"; }
@@ -109,7 +110,8 @@ PortRegistry::Port& PortRegistry::bind_frames(const std::string& port, const std
     n.info.type_version = frames::FrameChannel::kTypeVersion;
     n.info.size = n.frames->set_bytes();
     for (const frames::CameraSpec& c : cameras) {
-      n.info.cameras.push_back(c.name + " " + std::to_string(c.width) + "x" + std::to_string(c.height));
+      n.info.cameras.push_back(c.name + " " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                               (c.bytes_per_pixel == 1 ? "" : "x" + std::to_string(c.bytes_per_pixel)));
     }
   });
   CREASE_DEMAND(p.frames != nullptr, "a port of kind frames always has its channel");

@@ -18,6 +18,9 @@ FrameChannel::FrameChannel(std::string name, std::vector<CameraSpec> cameras)
     require_input(c.width > 0 && c.height > 0,
                   "frame channel '" + name_ + "': camera '" + c.name + "' has size " +
                       std::to_string(c.width) + "x" + std::to_string(c.height));
+    require_input(c.bytes_per_pixel >= 1 && c.bytes_per_pixel <= 4,
+                  "frame channel '" + name_ + "': camera '" + c.name + "' has " +
+                      std::to_string(c.bytes_per_pixel) + " bytes per pixel (1 to 4)");
     require_input(names.insert(c.name).second,
                   "frame channel '" + name_ + "': camera '" + c.name + "' listed twice");
   }

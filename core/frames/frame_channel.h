@@ -14,7 +14,8 @@
 //
 // One writer and one reader at a time. Both sides claim their end first; across a plugin
 // hot-swap the new instance's worker waits (wait_signal) until the old one released it.
-// Images are 8-bit grey, rows packed (stride = width).
+// Images are rows packed (stride = width * bytes_per_pixel): 8-bit grey for the colour cameras'
+// sets; a depth source's sets carry 16-bit depth and 8-bit BGR images (bytes_per_pixel 2 and 3).
 #pragma once
 
 #include <atomic>
@@ -28,11 +29,13 @@
 
 namespace crease::frames {
 
-// One camera of a frame set: its name (the calibration's, e.g. "cam0") and image size, pixels.
+// One image of a frame set: its name (the calibration's, e.g. "cam0") and size, pixels; bytes
+// per pixel 1 (8-bit grey, the default), 2 (16-bit depth) or 3 (8-bit BGR).
 struct CameraSpec {
   std::string name;
   int width = 0;
   int height = 0;
+  int bytes_per_pixel = 1;
   friend bool operator==(const CameraSpec&, const CameraSpec&) = default;
 };
 
@@ -79,7 +82,8 @@ class FrameChannel {
   [[nodiscard]] const std::vector<CameraSpec>& cameras() const noexcept { return cameras_; }
   [[nodiscard]] std::size_t image_bytes(std::size_t camera) const noexcept {
     return static_cast<std::size_t>(cameras_[camera].width) *
-           static_cast<std::size_t>(cameras_[camera].height);
+           static_cast<std::size_t>(cameras_[camera].height) *
+           static_cast<std::size_t>(cameras_[camera].bytes_per_pixel);
   }
   [[nodiscard]] std::size_t set_bytes() const noexcept;  // pixels of one frame set, all cameras
   [[nodiscard]] std::uint32_t all_cameras_mask() const noexcept;

@@ -16,11 +16,17 @@ std::vector<crease::frames::CameraSpec> channel_specs(const std::vector<Camera>&
 std::shared_ptr<crease::frames::FrameChannel> bind_images(crease::PortBinder& ports,
                                                           const std::vector<Camera>& cameras,
                                                           ImagesEnd end) {
-  auto channel = end == ImagesEnd::writer ? ports.frames_output(kImagesPort, channel_specs(cameras))
-                                          : ports.frames_input(kImagesPort, channel_specs(cameras));
+  return bind_image_specs(ports, kImagesPort, channel_specs(cameras), end);
+}
+
+std::shared_ptr<crease::frames::FrameChannel> bind_image_specs(
+    crease::PortBinder& ports, const char* port,
+    const std::vector<crease::frames::CameraSpec>& images, ImagesEnd end) {
+  auto channel = end == ImagesEnd::writer ? ports.frames_output(port, images)
+                                          : ports.frames_input(port, images);
   crease::require_input(
       channel->name().size() < crease::CameraFrames::kChannelNameCapacity,
-      "ports.images: frame channel name '" + channel->name() + "' is longer than " +
+      std::string("ports.") + port + ": frame channel name '" + channel->name() + "' is longer than " +
           std::to_string(crease::CameraFrames::kChannelNameCapacity - 1) + " characters");
   return channel;
 }

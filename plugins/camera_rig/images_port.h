@@ -28,5 +28,9 @@ enum class ImagesEnd { writer, reader };
 // CameraFrames::channel.
 [[nodiscard]] std::shared_ptr<crease::frames::FrameChannel> bind_images(
     crease::PortBinder& ports, const std::vector<Camera>& cameras, ImagesEnd end);
+// The same for any port of kind frames and any images (a depth source's: depth_camera.h).
+[[nodiscard]] std::shared_ptr<crease::frames::FrameChannel> bind_image_specs(
+    crease::PortBinder& ports, const char* port,
+    const std::vector<crease::frames::CameraSpec>& images, ImagesEnd end);
 
 }  // namespace crease::vision

@@ -72,16 +72,21 @@ class CameraPlugin : public crease::Plugin {
   void cleanup() override { worker_.reset(); }
 
  protected:
-  // Call last in configure, with the source the parameters describe.
+  // Call last in configure, with the source the parameters describe. The images go through the
+  // frame channel of port `images_port`, announced on `frames_port` (an RGB-D source: its own).
   void configure_camera(const crease::Params& p, crease::PortBinder& ports,
-                        std::unique_ptr<CameraSource> source, bool lockstep_default = true) {
+                        std::unique_ptr<CameraSource> source, bool lockstep_default = true,
+                        const char* images_port = kImagesPort, const char* frames_port = "frames") {
     lockstep_ = p.get<bool>("lockstep", lockstep_default);
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
     const std::string record = p.has("record") ? p.get_path("record") : std::string();
-    channel_ = bind_images(ports, source->cameras(), ImagesEnd::writer);
+    // The replay layout has one grey image per camera: a source with other images cannot record.
+    if (!record.empty() && source->channel_images() != channel_specs(source->cameras()))
+      p.fail("record", "this source's images (depth and colour) have no replay layout yet");
+    channel_ = bind_image_specs(ports, images_port, source->channel_images(), ImagesEnd::writer);
     std::memcpy(announce_.channel, channel_->name().c_str(), channel_->name().size() + 1);
     announce_.cameras = static_cast<std::uint32_t>(source->cameras().size());
-    out_ = ports.latest_output<crease::CameraFrames>("frames", crease::CameraFrames{});
+    out_ = ports.latest_output<crease::CameraFrames>(frames_port, crease::CameraFrames{});
     worker_ = std::make_unique<CameraWorker>(std::move(source), channel_, record);
   }
 

@@ -17,14 +17,18 @@
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "core/frames/frame_channel.h"
 #include "plugins/camera_rig/camera_model.h"
+#include "plugins/camera_rig/images_port.h"
 
 namespace crease::vision {
 
 struct Frame {
   std::int64_t timestamp_ns = 0;
   std::uint64_t index = 0;
-  std::vector<cv::Mat> images;  // one per camera, CV_8UC1; empty = nothing from that camera
+  // One per image of the source's channel_images(): CV_8UC1 for the colour cameras (one image
+  // per camera); a depth source's CV_16UC1 depth and CV_8UC3 colour. Empty = nothing delivered.
+  std::vector<cv::Mat> images;
   // Set by the caller: images[k] are buffers of the right size to write into (a frame channel's
   // set); a source that can fill them in place does (SimSource), instead of fresh buffers.
   bool fill_in_place = false;
@@ -34,6 +38,11 @@ class CameraSource {
  public:
   virtual ~CameraSource() = default;
   [[nodiscard]] virtual const std::vector<Camera>& cameras() const = 0;
+  // The images of one frame, in channel order: one 8-bit grey image per camera unless the
+  // source says otherwise (an RGB-D source: plugins/camera_rig/depth_camera.h).
+  [[nodiscard]] virtual std::vector<crease::frames::CameraSpec> channel_images() const {
+    return channel_specs(cameras());
+  }
   // Fills the next frame; false at the end of a recording (or when no camera delivers).
   virtual bool grab(Frame& frame) = 0;
   // Any thread: asks a grab() that waits (a replay pacing its frames) to return soon, and every

@@ -6,6 +6,19 @@
 #include "plugins/camera_rig/images_port.h"
 
 namespace crease::vision {
+namespace {
+
+// The OpenCV type of a channel image (frame_channel.h: 1 grey, 2 depth, 3 BGR bytes per pixel).
+int mat_type(const crease::frames::CameraSpec& spec) {
+  switch (spec.bytes_per_pixel) {
+    case 2: return CV_16UC1;
+    case 3: return CV_8UC3;
+    case 4: return CV_8UC4;
+    default: return CV_8UC1;
+  }
+}
+
+}  // namespace
 
 CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
                            std::shared_ptr<crease::frames::FrameChannel> channel,
@@ -13,7 +26,7 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
     : source_(std::move(source)), channel_(std::move(channel)) {
   // The plugin bound the channel with these cameras (plugins/camera_rig/images_port.h): the
   // registry checked them.
-  CREASE_DEMAND(channel_->cameras() == channel_specs(source_->cameras()),
+  CREASE_DEMAND(channel_->cameras() == source_->channel_images(),
                 "the frame channel does not have this source's cameras");
   if (!record_dir.empty()) recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras());
   writer_ = channel_->try_claim_writer();  // now if free, so the first request need not wait
@@ -77,7 +90,7 @@ void CameraWorker::point_at_write_set() {
   frame_.images.resize(channel_->cameras().size());
   for (std::size_t k = 0; k < frame_.images.size(); ++k) {
     const auto& spec = channel_->cameras()[k];
-    frame_.images[k] = cv::Mat(spec.height, spec.width, CV_8UC1, set.pixels(k));
+    frame_.images[k] = cv::Mat(spec.height, spec.width, mat_type(spec), set.pixels(k));
   }
   frame_.fill_in_place = true;
 }
@@ -88,13 +101,13 @@ std::uint32_t CameraWorker::copy_into_channel() {
   for (std::size_t k = 0; k < channel_->cameras().size() && k < frame_.images.size(); ++k) {
     const cv::Mat& im = frame_.images[k];
     const auto& spec = channel_->cameras()[k];
-    if (im.empty() || im.type() != CV_8UC1 || im.cols != spec.width || im.rows != spec.height)
+    if (im.empty() || im.type() != mat_type(spec) || im.cols != spec.width || im.rows != spec.height)
       continue;
     if (im.data == set.pixels(k) && im.isContinuous()) {  // filled in place
       valid |= 1u << k;
       continue;
     }
-    const auto row = static_cast<std::size_t>(spec.width);
+    const auto row = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.bytes_per_pixel);
     for (int y = 0; y < im.rows; ++y)
       std::memcpy(set.pixels(k) + row * static_cast<std::size_t>(y), im.ptr(y), row);
     valid |= 1u << k;

@@ -49,8 +49,14 @@ void CloudBuilder::configure(const CloudParams& p, const std::vector<vision::Cam
   check(p.voxel_mm > 0.0 && p.voxel_mm <= 1000.0, "voxel_mm", "must be in (0, 1000]");
   check(max_points >= 1 && max_points <= 50000000, "max_points", "must be in [1, 5e7]");
   check(!cameras.empty(), "cameras", "at least one depth camera");
+  check(p.camera_depth_unit_mm.empty() || p.camera_depth_unit_mm.size() == cameras.size(),
+        "depth_unit_mm", "one per camera");
+  for (const double u : p.camera_depth_unit_mm)
+    check(u > 0.0 && u <= 10.0, "depth_unit_mm", "must be in (0, 10]");
   params_ = p;
   cameras_ = cameras;
+  units_ = p.camera_depth_unit_mm.empty() ? std::vector<double>(cameras.size(), p.depth_unit_mm)
+                                          : p.camera_depth_unit_mm;
   rays_.assign(cameras.size(), {});
   for (std::size_t c = 0; c < cameras.size(); ++c) {
     const vision::Camera& cam = cameras[c];
@@ -83,6 +89,7 @@ bool CloudBuilder::add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) n
     return false;
   }
   const auto& rays = rays_[static_cast<std::size_t>(cam)];
+  const double unit = units_[static_cast<std::size_t>(cam)];
   // world = R^T (p_cam - t)
   Eigen::Matrix3d rt;
   for (int i = 0; i < 3; ++i)
@@ -100,7 +107,7 @@ bool CloudBuilder::add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) n
         ++counters_.masked_out;
         continue;
       }
-      const double z = drow[u] * params_.depth_unit_mm;
+      const double z = drow[u] * unit;
       if (drow[u] == 0 || z < params_.min_depth_mm || z > params_.max_depth_mm) {
         ++counters_.invalid_depth;
         continue;

@@ -36,6 +36,8 @@ void bgr_to_hsv(std::uint8_t b, std::uint8_t g, std::uint8_t r, int& h, int& s, 
 struct CloudParams {
   HsvRange mask;
   double depth_unit_mm = 1.0;   // one depth count in mm (D435 default 1 mm, D405 0.1 mm)
+  // Per camera (the calibrations' depth_unit_mm), overriding depth_unit_mm; empty: that for all.
+  std::vector<double> camera_depth_unit_mm;
   double min_depth_mm = 100.0;  // valid depth range along the optical axis, mm
   double max_depth_mm = 3000.0;
   double voxel_mm = 5.0;        // leaf size of the voxel grid, mm (> 0)
@@ -72,6 +74,7 @@ class CloudBuilder {
  private:
   CloudParams params_;
   std::vector<vision::Camera> cameras_;
+  std::vector<double> units_;                 // per camera, mm per count
   std::vector<std::vector<cv::Vec2f>> rays_;  // per camera, per pixel: undistorted (x/z, y/z)
   std::vector<Eigen::Vector3d> points_;       // capacity max_points
   std::vector<std::uint64_t> keys_;           // voxel key << 32 | point index, capacity max_points

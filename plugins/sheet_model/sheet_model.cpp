@@ -61,6 +61,8 @@ SheetModel::SheetModel(const SheetParams& params)
   keypoint_stencil_.resize(kMaxKeypoints);
   targets_.resize(kMaxTargets);
   target_stencil_.resize(kMaxTargets);
+  normal_targets_.resize(kMaxTargets);
+  normal_stencil_.resize(kMaxTargets);
   keypoint_gain_ = s.keypoint_gain_per_s;
   restore_link_stiffness();
   saved_rest_ = rest_;
@@ -213,6 +215,20 @@ int SheetModel::set_keypoints(std::span<const KeypointObs> k) noexcept {
     ++n_keypoints_;
   }
   return n_keypoints_;
+}
+
+int SheetModel::set_normal_targets(std::span<const NormalTarget> t) noexcept {
+  n_normal_targets_ = 0;
+  for (const NormalTarget& o : t) {
+    if (n_normal_targets_ >= kMaxTargets) break;
+    if (!is_finite(o.world_mm) || !std::isfinite(o.sheet_mm.u) || !std::isfinite(o.sheet_mm.v) ||
+        !(o.weight > 0.0 && o.weight <= 1.0))
+      continue;
+    normal_targets_[n_normal_targets_] = o;
+    normal_stencil_[n_normal_targets_] = stencil(o.sheet_mm);
+    ++n_normal_targets_;
+  }
+  return n_normal_targets_;
 }
 
 int SheetModel::set_targets(std::span<const TargetPoint> t) noexcept {

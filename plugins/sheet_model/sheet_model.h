@@ -32,6 +32,15 @@ struct TargetPoint {
   Vec2 sheet_mm;
 };
 
+// A depth target: sheet point `sheet_mm` pulled towards `world_mm` by a zero-length spring of
+// stiffness scaled by `weight` (0, 1], along the model's normal at that point when the solver's
+// depth_along_normal is set (the depth path: plugins/depth_tracking).
+struct NormalTarget {
+  Vec3 world_mm;
+  Vec2 sheet_mm;
+  double weight = 1.0;
+};
+
 struct Region {
   Vec2 min, max;  // axis-aligned rectangle in sheet mm
 };
@@ -92,6 +101,9 @@ class SheetModel {
   // dropped; returns the number accepted. RT.
   int set_keypoints(std::span<const KeypointObs> k) noexcept;
   int set_targets(std::span<const TargetPoint> t) noexcept;
+  // Depth targets (non-finite entries and weights outside (0, 1] dropped). Only the XPBD
+  // backend applies them (the ODE backend ignores them). RT.
+  int set_normal_targets(std::span<const NormalTarget> t) noexcept;
   void set_keypoint_gain(double lambda_per_s) noexcept { keypoint_gain_ = lambda_per_s; }
   // Nodes that no target or key-point of the current inputs touches move no faster than this
   // (mm/s; <= 0 or not finite: no limit beyond solver.max_speed_mm_per_s). RT.
@@ -103,7 +115,11 @@ class SheetModel {
     predicted_targets_ = predicted_targets;
     predicted_keypoints_ = predicted_keypoints;
   }
-  void clear_inputs() noexcept { n_keypoints_ = 0; n_targets_ = 0; }
+  void clear_inputs() noexcept {
+    n_keypoints_ = 0;
+    n_targets_ = 0;
+    n_normal_targets_ = 0;
+  }
 
   // A pinned node follows a prescribed position (infinite mass). RT.
   void pin(int node, Vec3 world_mm) noexcept;
@@ -172,6 +188,9 @@ class SheetModel {
   std::vector<TargetPoint> targets_;    // capacity kMaxTargets
   std::vector<SheetPointStencil> target_stencil_;
   int n_targets_ = 0;
+  std::vector<NormalTarget> normal_targets_;  // capacity kMaxTargets
+  std::vector<SheetPointStencil> normal_stencil_;
+  int n_normal_targets_ = 0;
   double keypoint_gain_ = 10.0;
   double unseen_speed_limit_ = 0.0;  // mm/s, <= 0: none
   bool links_learn_ = true;

@@ -1,6 +1,7 @@
 // Plugin `sheet_model` (model loop, 60 Hz by default): the sheet model of seed 000/001 kept
 // on the observed sheet.
 //   in:  keypoints (latest, Keypoints), target_points (latest, TargetPoints),
+//        depth_targets (latest, DepthTargets: the depth path's point-to-plane springs),
 //        crease (queue, SheetCreaseEvent), memorize (queue, SheetMemorizeEvent),
 //        reset (queue, SheetResetEvent)
 //   out: sheet_state (latest, SheetState)
@@ -19,11 +20,17 @@
 // predict_unseen_s (how long a key-point is still predicted after it was last seen),
 // bound_predictions (0/1: unseen key-points kept within their sheet distance of the seen),
 // unseen_speed_memory_s (nodes no key-point pulls move no faster than the fastest key-point
-// seen within this many seconds; 0: off).
+// seen within this many seconds; 0: off),
+// depth_compliance_m_per_n (a depth target of weight 1), depth_along_normal (default true: depth
+// targets pull along the model's normal only; false: 3-D springs), depth_predict (default false:
+// a depth target moves on at its node's velocity between the last two depth frames),
+// depth_tangential_weight (0.3: the share of the tangential error a depth target corrects).
+
 #include <memory>
 #include <string>
 
 #include "core/plugin.h"
+#include "core/port_types/depth_targets.h"
 #include "core/port_types/keypoints.h"
 #include "core/port_types/sheet_state.h"
 #include "plugins/sheet_model/sheet_runner.h"
@@ -53,6 +60,9 @@ class SheetModelPlugin final : public Plugin {
       p.fail("coupling", "must be springs or keypoints, not '" + coupling + "'");
     sp.solver.keypoint_gain_per_s = p.get_in_range<double>("keypoint_gain_per_s", 10.0, 0.0, 1e6);
     sp.solver.target_compliance_m_per_n = p.get_in_range<double>("target_compliance_m_per_n", 1e-6, 0.0, 1e3);
+    sp.solver.depth_compliance_m_per_n = p.get_in_range<double>("depth_compliance_m_per_n", 0.05, 0.0, 1e6);
+    sp.solver.depth_along_normal = p.get<bool>("depth_along_normal", true);
+    sp.solver.depth_tangential_weight = p.get_in_range<double>("depth_tangential_weight", 0.3, 0.0, 1.0);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
     sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
     sp.solver.yield_strain = p.get_in_range<double>("yield_strain", sp.solver.yield_strain, 0.0, 1.0);
@@ -67,9 +77,11 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.self_collision_every = p.get_in_range<int>("self_collision_every", 2, 1, 100);
     const double table = p.get_in_range<double>("table_height_mm", 0.0, -1e4, 1e4);
     runner_ = std::make_unique<sheet::SheetRunner>(sp, table);
+    runner_->set_depth_prediction(p.get<bool>("depth_predict", false));
     state_ = std::make_unique<SheetState>();
     keypoints_ = ports.latest_input<Keypoints>("keypoints");
     targets_ = ports.latest_input<TargetPoints>("target_points");
+    depth_ = ports.latest_input<DepthTargets>("depth_targets");
     crease_ = ports.queue_input<SheetCreaseEvent>("crease");
     memorize_ = ports.queue_input<SheetMemorizeEvent>("memorize");
     reset_ = ports.queue_input<SheetResetEvent>("reset");
@@ -79,6 +91,7 @@ class SheetModelPlugin final : public Plugin {
   Status update(const Cycle& cycle) override {
     if (keypoints_.bound() && keypoints_.poll().is_new()) runner_->observe_keypoints(keypoints_.value());
     if (targets_.bound() && targets_.poll().is_new()) runner_->set_targets(targets_.value());
+    if (depth_.bound() && depth_.poll().is_new()) runner_->set_depth_targets(depth_.value());
     SheetResetEvent r;
     while (reset_.bound() && reset_.try_pop(r)) runner_->apply(r);
     SheetCreaseEvent c;
@@ -98,6 +111,7 @@ class SheetModelPlugin final : public Plugin {
   std::unique_ptr<SheetState> state_;
   LatestInput<Keypoints> keypoints_;
   LatestInput<TargetPoints> targets_;
+  LatestInput<DepthTargets> depth_;
   QueueInput<SheetCreaseEvent> crease_;
   QueueInput<SheetMemorizeEvent> memorize_;
   QueueInput<SheetResetEvent> reset_;

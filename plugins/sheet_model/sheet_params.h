@@ -88,6 +88,15 @@ struct SolverParams {
   double keypoint_gain_per_s = 10.0;
   // Zero-length target springs (seed 001 Eq. 4): alpha_input, m/N.
   double target_compliance_m_per_n = 1e-6;
+  // Depth targets (SheetModel::set_normal_targets): alpha of a target of weight 1, m/N (a
+  // target of weight w has alpha / w); along_normal: the spring acts along the model's normal at
+  // its sheet point only (point-to-plane), else in 3-D like a target point.
+  double depth_compliance_m_per_n = 0.05;
+  bool depth_along_normal = true;
+  // With depth_along_normal: the share of the tangential error the spring corrects too (0: the
+  // normal only; 1: a 3-D spring). Depth says little about where along the surface a point lies,
+  // but not nothing (the sheet's edges): without any of it the sheet slides as the flap turns.
+  double depth_tangential_weight = 0.3;
   // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
   double friction = 0.5;
   bool self_collision = true;

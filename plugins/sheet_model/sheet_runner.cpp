@@ -22,6 +22,12 @@ SheetRunner::SheetRunner(std::unique_ptr<SheetModel> model, double table_height_
   predicted_.resize(SheetModel::kMaxTargets);
   keypoint_obs_.resize(SheetModel::kMaxKeypoints);
   external_.resize(TargetPoints::kCapacity);
+  depth_.resize(DepthTargets::kCapacity);
+  depth_used_targets_.resize(DepthTargets::kCapacity);
+  depth_node_.resize(DepthTargets::kCapacity);
+  node_last_.resize(model_->node_count());
+  node_vel_.resize(model_->node_count());
+  node_last_ns_.assign(model_->node_count(), std::numeric_limits<std::int64_t>::min());
   last_good_.assign(model_->positions().begin(), model_->positions().end());
   normals_.resize(model_->node_count());
   strain_.resize(model_->link_count());
@@ -47,6 +53,34 @@ void SheetRunner::set_targets(const TargetPoints& t) noexcept {
   for (std::uint32_t i = 0; i < n; ++i) {
     const auto& p = t.points[i];
     external_[n_external_++] = {{p.world_mm[0], p.world_mm[1], p.world_mm[2]}, {p.sheet_mm[0], p.sheet_mm[1]}};
+  }
+}
+
+void SheetRunner::set_depth_targets(const DepthTargets& t) noexcept {
+  n_depth_ = 0;
+  depth_stamp_ns_ = t.timestamp_ns;
+  const Grid& g = model_->grid();
+  const double du = g.du, dv = g.dv;
+  const std::uint32_t n = std::min(t.count, DepthTargets::kCapacity);
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const auto& p = t.points[k];
+    const NormalTarget nt{{p.world_mm[0], p.world_mm[1], p.world_mm[2]}, {p.sheet_mm[0], p.sheet_mm[1]}, p.weight};
+    // The grid node the target is on, if it is on one (the depth tracker's are).
+    const double fi = nt.sheet_mm.u / du, fj = nt.sheet_mm.v / dv;
+    const long i = std::lround(fi), j = std::lround(fj);
+    std::int32_t node = -1;
+    if (std::isfinite(fi) && std::isfinite(fj) && std::abs(fi - double(i)) < 1e-3 && std::abs(fj - double(j)) < 1e-3 &&
+        i >= 0 && j >= 0 && i < g.w && j < g.h && is_finite(nt.world_mm)) {
+      node = static_cast<std::int32_t>(j * g.w + i);
+      const std::int64_t last = node_last_ns_[node];
+      const bool near = last != std::numeric_limits<std::int64_t>::min() && t.timestamp_ns > last &&
+                        static_cast<double>(t.timestamp_ns - last) * 1e-9 <= kDepthMaxGapS;
+      node_vel_[node] = near ? (1e9 / static_cast<double>(t.timestamp_ns - last)) * (nt.world_mm - node_last_[node]) : Vec3{};
+      node_last_[node] = nt.world_mm;
+      node_last_ns_[node] = t.timestamp_ns;
+    }
+    depth_node_[n_depth_] = node;
+    depth_[n_depth_++] = nt;
   }
 }
 
@@ -79,6 +113,8 @@ void SheetRunner::apply(const SheetResetEvent&) noexcept {
   fit_good_s_ = 0;
   predictor_.clear();
   n_external_ = 0;
+  n_depth_ = 0;
+  std::fill(node_last_ns_.begin(), node_last_ns_.end(), std::numeric_limits<std::int64_t>::min());
   last_good_.assign(model_->positions().begin(), model_->positions().end());
 }
 
@@ -115,6 +151,18 @@ bool SheetRunner::step_rt(double dt_s, std::int64_t now_ns, SheetState& out) noe
                                    springs ? InputRange{} : predicted);
   }
   model_->set_links_learn(observations_ == 0 || fits);
+  const bool depth_fresh = n_depth_ > 0 && static_cast<double>(now_ns - depth_stamp_ns_) * 1e-9 <= kDepthMaxAgeS;
+  int nd = 0;
+  if (depth_fresh) {
+    const double ahead = std::clamp(static_cast<double>(now_ns - depth_stamp_ns_) * 1e-9, 0.0, kDepthMaxPredictS);
+    for (int k = 0; k < n_depth_; ++k) {
+      NormalTarget nt = depth_[k];
+      if (depth_predict_ && depth_node_[k] >= 0) nt.world_mm += ahead * node_vel_[depth_node_[k]];
+      depth_used_targets_[nd++] = nt;
+    }
+  }
+  depth_used_ = model_->set_normal_targets(
+      std::span<const NormalTarget>(depth_used_targets_.data(), static_cast<std::size_t>(nd)));
   model_->save_links_rt();  // with last_good_: the state this step starts from
   model_->step_rt(dt_s);
   ++steps_;

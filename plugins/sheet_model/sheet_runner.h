@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/port_types/depth_targets.h"
 #include "core/port_types/keypoints.h"
 #include "core/port_types/sheet_state.h"
 #include "collision_world.h"
@@ -33,6 +34,18 @@ class SheetRunner {
   // Inputs (RT). Times are CLOCK_MONOTONIC ns.
   void observe_keypoints(const Keypoints& k) noexcept;
   void set_targets(const TargetPoints& t) noexcept;
+  // The depth path's targets (point-to-plane springs, SheetModel::set_normal_targets), used by
+  // every step until replaced or until they are kDepthMaxAgeS older than the step. A target on a
+  // grid node that also had one in the previous set (at most kDepthMaxGapS before) moves on at
+  // the velocity between the two, for at most kDepthMaxPredictS (depth frames come at a few Hz
+  // to 30 Hz; the model steps at 60 Hz) when set_depth_prediction(true) (off by default: in real
+  // loops a late set extrapolated for long overshoots; measured in the depth_tracking plugin test).
+  void set_depth_targets(const DepthTargets& t) noexcept;
+  void set_depth_prediction(bool on) noexcept { depth_predict_ = on; }
+  static constexpr double kDepthMaxAgeS = 1.5;
+  static constexpr double kDepthMaxGapS = 0.5;
+  static constexpr double kDepthMaxPredictS = 0.5;
+  [[nodiscard]] int depth_targets_used() const noexcept { return depth_used_; }
   void apply(const SheetCreaseEvent& e) noexcept;
   void apply(const SheetMemorizeEvent& e) noexcept;
   void apply(const SheetResetEvent& e) noexcept;
@@ -59,6 +72,15 @@ class SheetRunner {
   std::vector<KeypointObs> keypoint_obs_;  // the predicted key-points for set_keypoints
   std::vector<TargetPoint> external_;
   int n_external_ = 0;
+  std::vector<NormalTarget> depth_;  // capacity DepthTargets::kCapacity
+  std::vector<NormalTarget> depth_used_targets_;  // depth_ predicted to the step's time
+  std::vector<std::int32_t> depth_node_;          // per target: its grid node, -1: none
+  std::vector<Vec3> node_last_, node_vel_;         // per node: last depth target, its velocity
+  std::vector<std::int64_t> node_last_ns_;         // per node: when (INT64_MIN: never)
+  bool depth_predict_ = false;
+  int n_depth_ = 0;
+  std::int64_t depth_stamp_ns_ = 0;
+  int depth_used_ = 0;
   std::vector<Vec3> last_good_, normals_;
   std::vector<double> strain_;
   std::int64_t epoch_ns_ = 0;

@@ -63,6 +63,8 @@ XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
   coupling_.configure(n);
   w_.assign(n, 0.0);
   target_rows_.resize(kMaxTargets);
+  normal_rows_.resize(kMaxTargets);
+  node_normals_.resize(n);
   kernel_.configure(topo_);
   cpu_simd_ = cpu_has_avx2_fma() && node_passes_simd_available();
   simd_ = cpu_simd_;
@@ -146,6 +148,50 @@ void XpbdSheet::project_targets() noexcept {
     if (!(r.inv_den > 0)) continue;
     const Vec3 c = r.b[0] * x[r.node[0]] + r.b[1] * x[r.node[1]] + r.b[2] * x[r.node[2]] + r.b[3] * x[r.node[3]];
     const Vec3 err = r.inv_den * (c - r.world);
+    for (int e = 0; e < 4; ++e) x[r.node[e]] -= r.wb[e] * err;
+  }
+}
+
+// Depth targets: seed 001 Eq. 4 on the sheet point c = sum b_e x_e, projected on the model's
+// unit normal n there (taken at the frame's start): with d = c - x_d split into its normal part
+// n (n . d) and the rest, x_e -= w_e b_e (n (n . d) + t (d - n (n . d))) / (sum w_e b_e^2 +
+// alpha / (weight dt_s^2)), t = depth_tangential_weight. Without depth_along_normal, the 3-D
+// spring of project_targets with that compliance.
+void XpbdSheet::prepare_normal_targets(double dt_s) noexcept {
+  if (n_normal_targets_ == 0) return;
+  const bool along = params_.solver.depth_along_normal;
+  if (along) compute_normals(node_normals_);
+  const double a = params_.solver.depth_compliance_m_per_n / (dt_s * dt_s);
+  for (int t = 0; t < n_normal_targets_; ++t) {
+    const SheetPointStencil& s = normal_stencil_[t];
+    NormalRow& r = normal_rows_[t];
+    double den = a / normal_targets_[t].weight;
+    Vec3 n{};
+    for (int e = 0; e < 4; ++e) {
+      r.node[e] = s.node[e];
+      r.b[e] = s.bilinear[e];
+      r.wb[e] = w_[s.node[e]] * s.bilinear[e];
+      den += r.wb[e] * s.bilinear[e];
+      if (along) n += s.bilinear[e] * node_normals_[s.node[e]];
+    }
+    const double nn = norm(n);
+    r.normal = along && nn > 1e-9 ? (1.0 / nn) * n : Vec3{};
+    r.inv_den = den > 0 && (!along || nn > 1e-9) ? 1.0 / den : 0.0;
+    r.world = normal_targets_[t].world_mm;
+  }
+}
+
+void XpbdSheet::project_normal_targets() noexcept {
+  Vec3* x = x_.data();
+  const bool along = params_.solver.depth_along_normal;
+  const double tw = params_.solver.depth_tangential_weight;
+  for (int t = 0; t < n_normal_targets_; ++t) {
+    const NormalRow& r = normal_rows_[t];
+    if (!(r.inv_den > 0)) continue;
+    const Vec3 c = r.b[0] * x[r.node[0]] + r.b[1] * x[r.node[1]] + r.b[2] * x[r.node[2]] + r.b[3] * x[r.node[3]];
+    const Vec3 d = c - r.world;
+    const Vec3 dn = dot(r.normal, d) * r.normal;
+    const Vec3 err = along ? r.inv_den * (dn + tw * (d - dn)) : r.inv_den * d;
     for (int e = 0; e < 4; ++e) x[r.node[e]] -= r.wb[e] * err;
   }
 }
@@ -240,6 +286,7 @@ void XpbdSheet::step_rt(double dt) noexcept {
   const double dts = dt / ns;
   prepare_frame(dts);
   prepare_targets(dts);
+  prepare_normal_targets(dts);
   const bool limit_unseen_nodes = unseen_speed_limit_ > 0 && std::isfinite(unseen_speed_limit_);
   if (limit_unseen_nodes) mark_unseen();
   detect_contacts(dt);
@@ -253,6 +300,7 @@ void XpbdSheet::step_rt(double dt) noexcept {
     predict_rt(x_, v_, prev_, pin_pos_, keep_, sp.gravity_mm_per_s2, damp, dts, simd_);  // seed 001 Eq. 1
     project_links();
     project_targets();
+    project_normal_targets();
     if (substep_contacts_ != nullptr) substep_contacts_->solve_rt(x_, prev_, w_, s, ns, dts);
     const int every = std::max(1, sp.self_collision_every);
     contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);

@@ -56,6 +56,8 @@ class XpbdSheet final : public SheetModel {
   void project_links() noexcept;
   void prepare_targets(double dt_s) noexcept;
   void project_targets() noexcept;
+  void prepare_normal_targets(double dt_s) noexcept;
+  void project_normal_targets() noexcept;
   void update_plasticity() noexcept;
   void mark_unseen() noexcept;
   void limit_unseen(double dts) noexcept;
@@ -71,6 +73,15 @@ class XpbdSheet final : public SheetModel {
     Vec3 world;             // target, mm
   };
   std::vector<TargetRow> target_rows_;  // capacity kMaxTargets
+  struct NormalRow {        // one depth target, fixed within a frame
+    std::int32_t node[4];
+    double b[4], wb[4];
+    double inv_den;         // 1 / (sum w_e b_e^2 + alpha / (weight dt_s^2)), 0: inactive
+    Vec3 world;             // target, mm
+    Vec3 normal;            // unit model normal at the sheet point (frame start); 0: 3-D spring
+  };
+  std::vector<NormalRow> normal_rows_;  // capacity kMaxTargets
+  std::vector<Vec3> node_normals_;      // per node, for the depth targets
   bool cpu_simd_ = false, simd_ = false;  // AVX2+FMA target and per-node passes (runtime check)
   std::vector<std::int64_t> keep_;       // per xyz component: -1 free node, 0 pinned (node_passes.h)
   LinkKernel kernel_;                        // link data, refreshed when links_version() or dt_s change

@@ -1,0 +1,92 @@
+// Plugin `camera_depth_sim`: the simulated world's RGB-D cameras (Realsense D435-like, overhead
+// and back: config/depth_cameras), rendering the sheet of the `sheet_truth` port into the frame
+// channel of `depth_images` (per camera a 16-bit depth and a registered BGR image:
+// plugins/camera_rig/depth_camera.h), each set announced on `depth_frames`. The noise model is
+// plugins/sim_world/scene/depth_view.h (sigma = z^2 subpixel / (f baseline), Intel's D400 figure).
+// Until the port has a value the cameras see the empty table.
+// Parameters: cameras: DIR (cam0.yaml.. with depth_unit_mm), sheet: plain | markers (layout:
+// for markers), sheet_colour: {b, g, r} (plain), seed, noise (grey levels), blur_px, occluders,
+// frame_period_s, depth_noise (bool), baseline_mm, subpixel, max_incidence_deg, edge_jump_mm,
+// min_range_mm, max_range_mm, table_z_mm, hand_height_mm; and camera_plugin.h's (no `record`:
+// depth has no replay layout yet).
+// Inputs: sheet_truth (crease::SheetState). Outputs: depth_images (frames), depth_frames.
+#include <memory>
+
+#include "core/port_types/sheet_state.h"
+#include "plugins/camera_rig/depth_camera.h"
+#include "plugins/camera_rig/marker_sheet.h"
+#include "plugins/cameras/camera_plugin.h"
+#include "plugins/sim_world/scene/depth_sim_source.h"
+#include "rt/clock.h"
+#include "rt/latest.h"
+
+namespace {
+
+using namespace crease::vision;
+
+class CameraDepthSimPlugin final : public CameraPlugin {
+ public:
+  void configure(const crease::Params& p, crease::PortBinder& ports) override {
+    auto cams = load_depth_camera_dir(p.get_path("cameras", "depth_cameras"));
+    const std::string sheet = p.get<std::string>("sheet", "plain");
+    DepthColourModel colour;
+    cv::Mat front, back;
+    double ppm = 1.0;
+    if (sheet == "plain") {
+      const crease::Params c = p.child("sheet_colour");
+      colour.sheet_bgr = cv::Vec3b(static_cast<std::uint8_t>(c.get_in_range<int>("b", 200, 0, 255)),
+                                   static_cast<std::uint8_t>(c.get_in_range<int>("g", 140, 0, 255)),
+                                   static_cast<std::uint8_t>(c.get_in_range<int>("r", 40, 0, 255)));
+      front = back = DepthSimSource::plain_texture(400.0, 400.0, ppm);
+    } else if (sheet == "markers") {
+      colour.plain = false;
+      ppm = 8.0;
+      const MarkerLayout layout = load_layout(p.get_path("layout", "markers/layout.yaml"));
+      front = face_texture(layout, Face::kFront, ppm);
+      back = face_texture(layout, Face::kBack, ppm);
+    } else {
+      p.fail("sheet", "must be plain or markers, not '" + sheet + "'");
+    }
+    RenderOptions ro;
+    ro.seed = static_cast<std::uint64_t>(p.get_in_range<int>("seed", 1, 0, 1 << 30));
+    ro.noise_sigma = p.get_in_range<double>("noise", 2.0, 0.0, 50.0);
+    ro.blur_sigma_px = p.get_in_range<double>("blur_px", 0.6, 0.0, 5.0);
+    ro.occluders = p.get_in_range<int>("occluders", 0, 0, 10);
+    DepthSensorModel sm;
+    sm.noise = p.get<bool>("depth_noise", true);
+    sm.baseline_mm = p.get_in_range<double>("baseline_mm", sm.baseline_mm, 1.0, 1000.0);
+    sm.subpixel = p.get_in_range<double>("subpixel", sm.subpixel, 0.0, 2.0);
+    sm.max_incidence_deg = p.get_in_range<double>("max_incidence_deg", sm.max_incidence_deg, 1.0, 90.0);
+    sm.edge_jump_mm = p.get_in_range<double>("edge_jump_mm", sm.edge_jump_mm, 0.1, 1e4);
+    sm.min_range_mm = p.get_in_range<double>("min_range_mm", sm.min_range_mm, 0.0, 1e5);
+    sm.max_range_mm = p.get_in_range<double>("max_range_mm", sm.max_range_mm, sm.min_range_mm, 1e5);
+    sm.table_z_mm = p.get_in_range<double>("table_z_mm", sm.table_z_mm, -1e4, 1e4);
+    sm.hand_height_mm = p.get_in_range<double>("hand_height_mm", sm.hand_height_mm, 0.0, 1e3);
+    const double period_s = p.get_in_range<double>("frame_period_s", 1.0 / 30, 1e-3, 10.0);
+    truth_in_ = ports.latest_input<crease::SheetState>("sheet_truth");
+    truth_ch_ = std::make_shared<crease::rt::LatestChannel>(sizeof(crease::SheetState));
+    auto mesh_at = [ch = truth_ch_, buf = std::make_shared<crease::SheetState>()](std::uint64_t) {
+      // Worker thread: the newest truth the RT side handed over (no sheet until there is one).
+      if (!ch->read(buf.get(), 0).has_data()) return SheetMesh{};
+      return mesh_of(*buf);
+    };
+    auto src = std::make_unique<DepthSimSource>(std::move(cams), front, back, ppm, mesh_at, ro, sm, colour,
+                                                static_cast<std::int64_t>(period_s * 1e9),
+                                                crease::rt::now_ns());
+    configure_camera(p, ports, std::move(src), true, kDepthImagesPort, kDepthFramesPort);
+  }
+
+  crease::Status update(const crease::Cycle& cycle) override {
+    // Hand the newest truth to the renderer before asking for the next frame.
+    if (truth_in_.poll().is_new()) truth_ch_->write(&truth_in_.value(), cycle.time_ns);
+    return CameraPlugin::update(cycle);
+  }
+
+ private:
+  crease::LatestInput<crease::SheetState> truth_in_;
+  std::shared_ptr<crease::rt::LatestChannel> truth_ch_;
+};
+
+}  // namespace
+
+CREASE_PLUGIN(CameraDepthSimPlugin, "camera_depth_sim", "0.1.0")

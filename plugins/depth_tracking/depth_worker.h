@@ -1,0 +1,66 @@
+// Runs the DepthTracker on a worker thread (non-RT: it takes milliseconds) over the frame sets a
+// depth source publishes into its frame channel (`depth_images`), with the newest sheet model
+// state the RT side handed over, and hands the targets back without locks or allocation, as the
+// vision worker does with key-points: woken by each publish, the newest set processed in place
+// (no copy of the images), the result written to a latest channel; the RT side copies it out.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/frames/frame_channel.h"
+#include "core/port_types/depth_targets.h"
+#include "core/port_types/sheet_state.h"
+#include "plugins/depth_tracking/depth_tracker.h"
+#include "rt/latest.h"
+
+namespace crease::depth {
+
+class DepthWorker {
+ public:
+  // `channel` holds `cameras`' images (plugins/camera_rig/depth_camera.h; CREASE_DEMAND). The
+  // reader end is claimed now if free, else on the worker thread once the previous reader
+  // released it (a hot swap).
+  DepthWorker(std::shared_ptr<crease::frames::FrameChannel> channel,
+              const std::vector<vision::DepthCamera>& cameras, const TrackerParams& params);
+  ~DepthWorker();
+  DepthWorker(const DepthWorker&) = delete;
+  DepthWorker& operator=(const DepthWorker&) = delete;
+
+  // RT-safe: the model's newest state for the next frames (copied into a latest channel).
+  void set_model_rt(const crease::SheetState& model, std::int64_t now_ns) noexcept {
+    model_.write(&model, now_ns);
+  }
+  enum class Take { none, fresh, failed };
+  // RT-safe. Copies the newest result into `out` when there is one not yet taken.
+  Take take_rt(crease::DepthTargets& out) noexcept;
+  [[nodiscard]] std::uint64_t sets_processed() const noexcept {
+    return processed_.load(std::memory_order_acquire);
+  }
+  [[nodiscard]] std::string error() const;  // non-RT, valid after `failed`
+
+ private:
+  void run();
+  bool claim_reader();
+
+  std::shared_ptr<crease::frames::FrameChannel> channel_;
+  DepthTracker tracker_;
+  std::unique_ptr<crease::SheetState> model_buf_;  // worker thread
+  std::unique_ptr<crease::DepthTargets> result_;   // worker thread
+  std::vector<cv::Mat> depth_, bgr_;               // worker thread: headers over the set
+  crease::rt::LatestChannel model_{sizeof(crease::SheetState)};
+  crease::rt::LatestChannel results_{sizeof(crease::DepthTargets)};
+  std::uint64_t taken_ = 0;  // RT side
+  std::string error_;
+  bool reader_ = false;
+  std::atomic<bool> failed_{false};
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> processed_{0};
+  std::thread thread_;
+};
+
+}  // namespace crease::depth

@@ -1,0 +1,43 @@
+// Which of the sheet model's nodes each depth camera sees, from the model itself (seed 001's
+// layer ambiguity: once a flap covers the lower layer, the cloud from above is the flap's, and
+// the lower layer's nodes must not be pulled onto it). The model's grid triangles are rasterised
+// per camera at 1/scale of its resolution into a depth buffer that keeps, per pixel, the grid
+// cell of the nearest surface. A node is seen by a camera when it projects inside the image, in
+// front of it, and the nearest surface at one of the 3 x 3 pixels around it is a grid cell at
+// most `cells` steps from the node's own cells (its own layer there, not a layer lying over it:
+// no depth tolerance, so layers a millimetre apart are told apart). configure() allocates; compute()
+// allocates nothing and throws nothing.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "plugins/camera_rig/camera_model.h"
+
+namespace crease::depth {
+
+class NodeVisibility {
+ public:
+  // Non-RT. nodes_u x nodes_v grid (row by row); scale >= 1; cells >= 0. Throws ConfigError.
+  void configure(const std::vector<vision::Camera>& cameras, int nodes_u, int nodes_v, int scale, int cells);
+  // nodes: the grid's world positions (mm). seen[i]: bit k set when camera k (of those in
+  // camera_mask) sees node i. RT-safe; false on a wrong size.
+  bool compute(std::span<const Eigen::Vector3d> nodes, std::uint32_t camera_mask,
+               std::span<std::uint32_t> seen) noexcept;
+
+ private:
+  struct View {
+    vision::Camera cam;  // intrinsics scaled by 1/scale
+    int w = 0, h = 0;
+    std::vector<float> zbuf;          // camera z, mm; +inf: no surface
+    std::vector<std::int32_t> cell;   // grid cell (j * (nodes_u - 1) + i) of the nearest surface
+  };
+  std::vector<View> views_;
+  std::vector<Eigen::Vector3d> proj_;  // per node: pixel x, y (scaled), camera z (<= 0: behind)
+  int nu_ = 0, nv_ = 0, cells_ = 1;
+};
+
+}  // namespace crease::depth

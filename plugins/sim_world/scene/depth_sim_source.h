@@ -1,0 +1,54 @@
+// The simulated RGB-D cameras: a CameraSource (plugins/cameras/camera_source.h) whose frames are,
+// per calibrated depth camera, the 16-bit depth and the registered BGR colour image of the sheet
+// mesh the scene holds for that frame (depth_view.h: the D4xx noise model), in the channel order
+// of plugins/camera_rig/depth_camera.h. The `camera_depth_sim` plugin feeds it the `sheet_truth`
+// port. Not RT code: it runs on a camera worker thread.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "plugins/camera_rig/depth_camera.h"
+#include "plugins/cameras/camera_source.h"
+#include "plugins/sim_world/scene/depth_view.h"
+#include "plugins/sim_world/scene/sheet_mesh.h"
+#include "plugins/sim_world/scene/view_renderer.h"
+
+namespace crease::vision {
+
+class DepthSimSource final : public CameraSource {
+ public:
+  // plain: the sheet in colour.sheet_bgr (a uniform texture), else the marker faces given.
+  // Frame i is stamped with its mesh's time when it has one, else start_ns + i * period_ns;
+  // its noise seed is render.seed + i.
+  DepthSimSource(std::vector<DepthCamera> cameras, const cv::Mat& front, const cv::Mat& back,
+                 double tex_px_per_mm, std::function<SheetMesh(std::uint64_t)> mesh_at,
+                 RenderOptions render, DepthSensorModel sensor, DepthColourModel colour,
+                 std::int64_t period_ns, std::int64_t start_ns = 0);
+  [[nodiscard]] const std::vector<Camera>& cameras() const override { return cams_; }
+  [[nodiscard]] std::vector<crease::frames::CameraSpec> channel_images() const override {
+    return depth_channel_specs(cams_);
+  }
+  bool grab(Frame& frame) override;  // never ends
+
+  // A plain sheet's texture (uniform white) for the constructor's front and back.
+  [[nodiscard]] static cv::Mat plain_texture(double w_mm, double h_mm, double px_per_mm);
+
+ private:
+  std::vector<DepthCamera> depth_cams_;
+  std::vector<Camera> cams_;
+  std::vector<cv::Mat> rays_;
+  ViewRenderer renderer_;
+  std::function<SheetMesh(std::uint64_t)> mesh_at_;
+  RenderOptions render_;
+  DepthSensorModel sensor_;
+  DepthColourModel colour_;
+  std::int64_t period_ns_;
+  std::int64_t start_ns_;
+  std::uint64_t next_ = 0;
+  RenderedView view_;
+};
+
+}  // namespace crease::vision

@@ -1,0 +1,154 @@
+// The depth path end to end, depth only, on a plain (unprinted) sheet: sheet_truth plays the
+// half fold (and announces its crease, as the folding sequence would), camera_depth_sim renders
+// it with the two D435s of config/depth_cameras, depth_tracking registers the model onto their
+// cloud and sheet_model takes the targets. The model, scored against the truth of the same model
+// cycle, tracks the fold; with the depth targets off (no depth_tracking) it stays flat and the
+// same bound fails by far. Nothing allocates in the loops' updates.
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/plugin_host.h"
+#include "core/port_types/depth_targets.h"
+#include "core/port_types/sheet_state.h"
+#include "rt/alloc_guard.h"
+#include "rt/clock.h"
+
+using namespace std::chrono_literals;
+
+namespace {
+const std::string kSrc = CREASE_SOURCE_DIR;
+constexpr int kNodes = 15 * 21;
+
+struct Host {
+  crease::PluginHost host{{CREASE_PLUGIN_DIR}};
+  void add(const std::string& name, const std::string& library, const std::string& loop, int order,
+           const std::string& yaml) {
+    crease::InstanceSpec s;
+    s.name = name;
+    s.library = library;
+    s.loop = loop;
+    s.order = order;
+    s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
+    host.add_instance(s);
+  }
+  template <class T>
+  bool read(const std::string& port, T& out) {
+    const auto* ch = host.ports().find_latest(port);
+    return ch != nullptr && ch->read(&out, 0).has_data();
+  }
+};
+
+double mean_distance(const crease::SheetState& a, const crease::SheetState& b) {
+  double s = 0;
+  for (int k = 0; k < kNodes; ++k)
+    s += std::hypot(a.position_mm[k][0] - b.position_mm[k][0], a.position_mm[k][1] - b.position_mm[k][1],
+                    a.position_mm[k][2] - b.position_mm[k][2]);
+  return s / kNodes;
+}
+
+struct Run {
+  double mean_mm = 0, worst_mm = 0, end_mm = 0;
+  int samples = 0;
+  std::uint32_t targets = 0, visible = 0, cloud = 0, iterations = 0;
+  std::uint64_t depth_frames = 0;
+  bool allocation_free = true;
+};
+
+constexpr double kStartS = 0.5;  // the fold starts then (sheet_truth's start_s), 175 deg 5 s later
+
+// Runs the fold to 1 s into its hold; scores every model state against the truth of its cycle.
+Run fold(bool depth) {
+  Host h;
+  h.host.add_loop({"vision", 30.0, 0, -1});
+  h.host.add_loop({"model", 60.0, 0, -1});
+  h.add("truth", "sheet_truth", "model", 1, "{start_s: " + std::to_string(kStartS) + "}");
+  h.add("sheet", "sheet_model", "model", 10, "{origin_x_mm: -105, origin_y_mm: 148.5}");
+  if (depth) {
+    h.add("depth_cams", "camera_depth_sim", "vision", 5, "{cameras: depth_cameras, sheet: plain, noise: 1.0}");
+    h.add("depth", "depth_tracking", "vision", 10,
+          "{cameras: depth_cameras, mask: {h_lo: 95, h_hi: 115, s_lo: 120, v_lo: 40}, voxel_mm: 6,"
+          " cpd: {max_iterations: 15, sigma2_init_mm2: 25, sigma2_min_mm2: 2}}");
+  }
+  auto truth = std::make_unique<crease::SheetState>();
+  auto model = std::make_unique<crease::SheetState>();
+  auto targets = std::make_unique<crease::DepthTargets>();
+  std::map<std::int64_t, std::unique_ptr<crease::SheetState>> truths;
+  std::int64_t t0 = -1;
+  Run r;
+  double sum = 0;
+  std::uint64_t allocations = 0;
+  bool counting = false;
+  std::int64_t last_model_ns = -1;
+  REQUIRE(crease::rt::alloc_hooks_installed());
+  h.host.start();
+  const std::int64_t limit = crease::rt::now_ns() + 60'000'000'000;
+  while (crease::rt::now_ns() < limit) {
+    h.host.poll();
+    if (h.read("sheet_truth", *truth) && truth->nodes_u == 15 && !truths.count(truth->timestamp_ns)) {
+      if (t0 < 0) t0 = truth->timestamp_ns;
+      truths.emplace(truth->timestamp_ns, std::make_unique<crease::SheetState>(*truth));
+    }
+    if (depth && h.read("depth_targets", *targets) && targets->count > 0) {
+      r.depth_frames = std::max<std::uint64_t>(r.depth_frames, targets->frame);
+      r.targets = targets->count;
+      r.visible = targets->visible_nodes;
+      r.cloud = targets->cloud_points;
+      r.iterations = targets->iterations;
+      if (!counting) {  // every plugin past its first cycles: from here on nothing allocates
+        counting = true;
+        allocations = crease::rt::rt_allocation_count();
+      }
+    }
+    if (h.read("sheet_state", *model) && model->nodes_u == 15 && model->timestamp_ns != last_model_ns) {
+      last_model_ns = model->timestamp_ns;
+      const auto it = truths.find(model->timestamp_ns);
+      const double t = t0 < 0 ? 0 : double(model->timestamp_ns - t0) * 1e-9;
+      if (it != truths.end() && t >= kStartS) {
+        const double e = mean_distance(*model, *it->second);
+        sum += e;
+        r.worst_mm = std::max(r.worst_mm, e);
+        r.end_mm = e;
+        ++r.samples;
+        truths.erase(truths.begin(), it);
+      }
+      if (t > kStartS + 6.0) break;
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  if (counting) r.allocation_free = crease::rt::rt_allocation_count() == allocations;
+  h.host.stop();
+  r.mean_mm = r.samples > 0 ? sum / r.samples : 1e9;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("depth only, plain sheet: the model tracks the half fold; without the depth targets it does not") {
+  const Run on = fold(true);
+  MESSAGE("depth targets on: mean node error " << on.mean_mm << " mm over " << on.samples
+                                               << " model states of the fold, worst " << on.worst_mm << " mm, at the end "
+                                               << on.end_mm << " mm; depth frames " << on.depth_frames
+                                               << ", last frame: " << on.targets << " targets, " << on.visible
+                                               << " nodes visible, " << on.cloud << " cloud points, " << on.iterations
+                                               << " CPD iterations");
+  const Run off = fold(false);
+  MESSAGE("depth targets off: mean node error " << off.mean_mm << " mm, worst " << off.worst_mm << " mm, at the end "
+                                                << off.end_mm << " mm");
+  REQUIRE(on.samples > 100);
+  REQUIRE(off.samples > 100);
+  REQUIRE(on.depth_frames >= 10);  // the loaded machine renders and registers a few frames a second at least
+  constexpr double kMeanBoundMm = 8.0;
+  constexpr double kEndBoundMm = 5.0;
+  CHECK(on.mean_mm <= kMeanBoundMm);
+  CHECK(on.end_mm <= kEndBoundMm);
+  CHECK(off.mean_mm > 3 * kMeanBoundMm);  // the physics alone does not fold the sheet
+  CHECK(off.end_mm > 3 * kEndBoundMm);
+  CHECK(on.allocation_free);
+}
