@@ -206,7 +206,9 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
           }
           continue;
         }
-        if (s.phase == SequenceStatus::done || s.phase == SequenceStatus::aborted) {
+        // Aborted once the retreat ended (the phase is `aborted` while it runs, under abort/).
+        const bool retreat_over = std::strncmp(s.path, "aborted", sizeof s.path) == 0;
+        if (s.phase == SequenceStatus::done || (s.phase == SequenceStatus::aborted && retreat_over)) {
           if (ended_ns == 0) ended_ns = rt::now_ns();
           const bool retained = s.phase != SequenceStatus::done || since(ended_ns) >= o.retain_s;
           if (retained && since(ended_ns) >= 0.5) {
