@@ -24,6 +24,7 @@ const char* to_string(HostEvent::Type t) noexcept {
     case HostEvent::Type::deactivated: return "deactivated";
     case HostEvent::Type::device_fault: return "device fault";
     case HostEvent::Type::device_recovered: return "device recovered";
+    case HostEvent::Type::mark: return "mark";
   }
   return "unknown";
 }
@@ -342,12 +343,19 @@ void PluginHost::drain_locked() {
     }
     rt::LogRecord r;
     while (l->log_queue().try_pop(r)) {
+      if (r.level == rt::LogLevel::mark) {  // on the timeline, as the plugin's event (the sink logs it)
+        rt::LogRecord text_only = r;
+        text_only.source[0] = '\0';
+        record({HostEvent::Type::mark, r.source, l->spec().name, rt::format_log_record(text_only), 0, r.time_ns});
+        continue;
+      }
       const std::string text = rt::format_log_record(r);
       switch (r.level) {
         case rt::LogLevel::debug: spdlog::debug("{}", text); break;
         case rt::LogLevel::info: spdlog::info("{}", text); break;
         case rt::LogLevel::warn: spdlog::warn("{}", text); break;
         case rt::LogLevel::error: spdlog::error("{}", text); break;
+        case rt::LogLevel::mark: break;
       }
     }
     // Each retired instance waits for its own loop's acknowledgement, not any loop's.

@@ -43,7 +43,8 @@ struct InstanceSpec {
 
 // Something that happened to an instance, for logs and the report's timeline.
 struct HostEvent {
-  enum class Type { loaded, unloaded, swapped, swap_state_lost, fault, activated, deactivated, device_fault, device_recovered };
+  // mark: a plugin's log_rt(LogLevel::mark, ...), e.g. a folding sequence's transition.
+  enum class Type { loaded, unloaded, swapped, swap_state_lost, fault, activated, deactivated, device_fault, device_recovered, mark };
   Type type = Type::loaded;
   std::string instance;
   std::string loop;

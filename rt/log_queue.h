@@ -18,7 +18,9 @@
 
 namespace crease::rt {
 
-enum class LogLevel : std::uint8_t { debug, info, warn, error };
+// mark: a moment of the run for its report's timeline (the plugin host records it as an event of
+// the instance, with the record's time; logged at info).
+enum class LogLevel : std::uint8_t { debug, info, warn, error, mark };
 
 struct LogRecord {
   std::int64_t time_ns = 0;   // CLOCK_MONOTONIC

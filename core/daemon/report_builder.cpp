@@ -35,6 +35,7 @@ const char* event_kind(HostEvent::Type t) {
     case HostEvent::Type::deactivated: return "deactivate";
     case HostEvent::Type::device_fault: return "device_fault";
     case HostEvent::Type::device_recovered: return "device_recovered";
+    case HostEvent::Type::mark: return "mark";
   }
   return "event";
 }

@@ -28,6 +28,11 @@ struct ArmGoal {
     world = 0,  // points in the world frame
     sheet = 1,  // points in the sheet frame as sheet_state gives it at the motion's start:
                 // origin node (0, 0), x towards node (W-1, 0) (u), z = u x v, y = z x x
+    measured = 2,  // relative to the tool frame's measured pose at the motion's start (the
+                   // forward kinematics of arm_state's angles): each point's position is an
+                   // offset along the world's axes, its orientation a rotation in the world
+                   // frame applied to the measured orientation (identity: keep it). A lift
+                   // from where the arm is, wherever a stopped motion left it.
   };
   enum StopOn : std::uint8_t {
     stop_none = 0,

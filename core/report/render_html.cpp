@@ -140,7 +140,7 @@ std::string svg_timeline(const TimingReport& r) {
   s += "<text x=\"4\" y=\"" + num(row_y + 4) + "\">events</text>";
   for (const Event& e : r.events) {
     const bool fault = e.kind == "fault" || e.kind == "device_fault";
-    const char* color = fault ? "#c00" : (e.kind == "hot_swap" ? "#06c" : "#888");
+    const char* color = fault ? "#c00" : (e.kind == "hot_swap" ? "#06c" : (e.kind == "mark" ? "#090" : "#888"));
     s += "<circle cx=\"" + num(x(e.time_ns)) + "\" cy=\"" + num(row_y) + "\" r=\"6\" fill=\"" +
          color + "\"><title>" + esc(e.kind + " " + e.loop + "/" + e.plugin + " " + e.detail) +
          "</title></circle>";

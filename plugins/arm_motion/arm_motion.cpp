@@ -103,9 +103,9 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   }
   if (r == ArmMotionReason::none && hand_retreating(in)) r = ArmMotionReason::hand_retreat;
   if (r == ArmMotionReason::none && g.frame == ArmGoal::sheet && world_sheet == nullptr) r = ArmMotionReason::no_sheet;
-  // The points in the world frame, metres.
+  // The points in the world frame, metres (relative to the measured pose: below, once the tool is set).
   CartesianPath path;
-  if (r == ArmMotionReason::none) {
+  if (r == ArmMotionReason::none && g.frame != ArmGoal::measured) {
     const KDL::Frame frame = g.frame == ArmGoal::sheet ? *world_sheet : KDL::Frame::Identity();
     for (int k = 0; k < g.point_count && r == ArmMotionReason::none; ++k) {
       const double* q = g.orientation[k];
@@ -133,9 +133,26 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   }
   const KDL::Frame off = ik_.tool_offset();
   const PathPose o = to_pose(off);
+  ik_.set_tool_offset(tool, to_frame(o));  // as load_state will: a swapped motion runs the same numbers
+  if (g.frame == ArmGoal::measured) {
+    // From where the arm is (its readiness above: a fresh arm_state), not where it was commanded.
+    double q_meas[kArmJoints];
+    for (int j = 0; j < kArmJoints; ++j) q_meas[j] = in.arm->position_rad[j];
+    const KDL::Frame here = ik_.tool_pose(std::span<const double, kArmJoints>(q_meas, kArmJoints));
+    for (int k = 0; k < g.point_count; ++k) {
+      const double* q = g.orientation[k];
+      const KDL::Frame world(KDL::Rotation::Quaternion(q[0], q[1], q[2], q[3]) * here.M,
+                             here.p + KDL::Vector(g.position_mm[k][0], g.position_mm[k][1], g.position_mm[k][2]) / 1000.0);
+      const double p_mm[3] = {1000.0 * world.p.x(), 1000.0 * world.p.y(), 1000.0 * world.p.z()};
+      if (!p_.workspace.contains(p_mm)) {
+        refuse(g.id, ArmMotionReason::outside_workspace);
+        return;
+      }
+      path.pose[k + 1] = to_pose(world);
+    }
+  }
   std::memcpy(s_.offset_p, o.p_m, sizeof(s_.offset_p));
   std::memcpy(s_.offset_quat, o.quat, sizeof(s_.offset_quat));
-  ik_.set_tool_offset(tool, to_frame(o));  // as load_state will: a swapped motion runs the same numbers
   path.pose[0] = to_pose(ik_.tool_pose(q_cmd));
   path.count = g.point_count + 1;
   set_path_limits(path, PathLimits{g.speed_mm_s * 1e-3, g.accel_mm_s2 * 1e-3, g.angular_speed_rad_s,

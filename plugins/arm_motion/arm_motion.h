@@ -18,6 +18,8 @@
 // each cycle the path profile steps (cartesian_path.h) and the IK tracks the new pose warm
 // from the last command (ArmIk::track); the command's velocity is the step over the cycle.
 //
+// A goal in the `measured` frame is relative to the tool frame's measured pose when it arrives
+// (the forward kinematics of arm_state's angles): a lift from where the arm is.
 // Stop condition (contact_onset): checked every running cycle before the profile steps, so a
 // fired condition starts the deceleration (at the goal's stop_accel) in the same cycle; at rest
 // the state is stopped_on_contact. A stale or unhealthy contact_state while armed decelerates

@@ -65,12 +65,13 @@ void Machine::arm_stop(int side, Outbox& out) noexcept {
 
 void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
   if (!m_.arm_has_target[side]) return;  // never moved: where it parked
-  double p[3] = {m_.arm_target[side][0], m_.arm_target[side][1], m_.arm_target[side][2]};
-  // Up: the world's +z, the sheet frame's -z (z = u x v points into the table).
-  p[2] += m_.arm_frame[side] == ArmGoal::sheet ? -lift_mm : lift_mm;
-  const double q[4] = {m_.arm_orientation[side][0], m_.arm_orientation[side][1], m_.arm_orientation[side][2],
-                       m_.arm_orientation[side][3]};
-  arm_move(side, m_.arm_tool[side], m_.arm_frame[side], p, q, spec_.retreat, 0, out);
+  // Straight up from where the tool is measured to be (arm_motion's `measured` frame), not from
+  // the last target: a motion stopped on its way (a contact, an abort) left the arm short of it,
+  // and a line from there to above the target could sweep through the sheet. The orientation
+  // is kept.
+  const double p[3] = {0.0, 0.0, lift_mm};
+  const double q[4] = {0.0, 0.0, 0.0, 1.0};
+  arm_move(side, m_.arm_tool[side], ArmGoal::measured, p, q, spec_.retreat, 0, out);
 }
 
 void Machine::arm_park(int side, Outbox& out) noexcept {

@@ -78,10 +78,20 @@ Status FoldSequencePlugin::update(const Cycle& c) {
 
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);
-  if (status_value_.transitions != logged_transitions_) {  // each transition: the new path, then why
+  if (status_value_.transitions != logged_transitions_) {
+    // Each transition on the report's timeline (the host records a mark as this instance's
+    // event, at the time it was logged, and logs it): "fold/shift/contact: arm_r reached".
     logged_transitions_ = status_value_.transitions;
-    log_rt(rt::LogLevel::info, status_value_.path, static_cast<std::int64_t>(status_value_.transitions));
-    log_rt(rt::LogLevel::info, status_value_.why);
+    char text[96];
+    std::size_t n = 0;
+    const auto append = [&](const char* s, std::size_t max) {
+      for (std::size_t i = 0; i < max && s[i] != '\0' && n + 1 < sizeof text; ++i) text[n++] = s[i];
+    };
+    append(status_value_.path, sizeof status_value_.path);
+    append(": ", 2);
+    append(status_value_.why, sizeof status_value_.why);
+    text[n] = '\0';
+    log_rt(rt::LogLevel::mark, text);
   }
   return status_value_.phase == SequenceStatus::aborted ? Status::degraded : Status::ok;
 }

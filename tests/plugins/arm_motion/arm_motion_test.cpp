@@ -544,6 +544,52 @@ TEST_CASE("a sheet-frame goal's points are taken relative to the sheet frame giv
   CHECK(mm(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)).p - shifted(start, 20, 30, -10).p) < 0.01);
 }
 
+TEST_CASE("a measured-frame goal moves the tool from where the arm is measured, not from where it is commanded") {
+  Rig r;
+  idle(r);
+  // A drive that lags its command (as one stopped on its way would): the arm measured 10 mrad
+  // behind on the shoulder and elbow joints, held there.
+  r.follow = false;
+  r.q_arm[0] += 0.01;
+  r.q_arm[3] -= 0.01;
+  idle(r, 2);
+  Joints measured{};
+  for (int j = 0; j < robot::kArmJoints; ++j) measured[j] = static_cast<float>(r.q_arm[j]);  // as arm_state carries it
+  const KDL::Frame here = r.tool_pose_at(ToolFrame::ff_pad, measured);
+  const KDL::Frame commanded = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+  MESSAGE("measured vs commanded tool frame: " << mm(here.p - commanded.p) << " mm apart");
+  REQUIRE(mm(here.p - commanded.p) > 3.0);
+  const KDL::Frame lifted = shifted(here, 0, 0, 30);  // 30 mm straight up from where it is
+  ArmGoal lift = goal_to(ToolFrame::ff_pad, KDL::Frame::Identity(), 21);
+  lift.frame = ArmGoal::measured;
+  lift.position_mm[0][2] = 30.0;
+  bool old_way = false;
+  SUBCASE("measured: an offset from the measured pose") {}
+  SUBCASE("failing variant: the same lift from the commanded pose (a world goal 30 mm above it)") {
+    old_way = true;
+    lift = goal_to(ToolFrame::ff_pad, shifted(commanded, 0, 0, 30), 21);
+  }
+  REQUIRE(r.cycle(&lift));
+  r.run_to_end();
+  REQUIRE(r.motion->status().state == ArmMotionStatus::reached);
+  const KDL::Frame end = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+  if (old_way) {
+    CHECK(mm(end.p - lifted.p) > 3.0);
+    return;
+  }
+  CHECK(mm(end.p - lifted.p) < 0.01);
+  CHECK(rot_angle(end.M, here.M) < 1e-5);  // the orientation kept
+  // Offsets leaving the workspace are refused as any point would be; nothing moves.
+  const Joints q0 = q_cmd(r);
+  ArmGoal far = lift;
+  far.id = 22;
+  far.position_mm[0][2] = 5000.0;
+  REQUIRE(r.cycle(&far));
+  CHECK(r.motion->status().last_refused_id == 22);
+  CHECK(r.motion->status().last_refusal == static_cast<std::uint8_t>(ArmMotionReason::outside_workspace));
+  CHECK(q_cmd(r) == q0);
+}
+
 TEST_CASE("hot-swap: a motion saved mid-way and loaded into a new controller goes on bit for bit") {
   Rig a, b;
   idle(a);

@@ -29,6 +29,11 @@ TEST_CASE("each defect of a goal names its reason") {
   g.kind = 9;
   CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
   g = good();
+  g.frame = ArmGoal::measured;  // the three frames are known
+  CHECK(check_goal(g, l) == ArmMotionReason::none);
+  g.frame = 3;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+  g = good();
   g.stop_on = 5;
   CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
   g = good();

@@ -56,6 +56,17 @@ void check_retreat(const Rig& r, long abort_cycle) {
     CHECK(arm.back()->arm_goal.kind == ArmGoal::move);
     CHECK(arm.back()->arm_goal.frame == ArmGoal::world);  // parked
     CHECK(arm.back()->arm_goal.position_mm[0][2] == 300.0);
+    // An arm that had moved lifts first: straight up by release_lift_mm from where it is
+    // measured (arm_motion's `measured` frame, the orientation kept), not from its last target.
+    for (std::size_t i = 1; i + 1 < arm.size(); ++i) {
+      const ArmGoal& g = arm[i]->arm_goal;
+      CHECK(g.kind == ArmGoal::move);
+      CHECK(g.frame == ArmGoal::measured);
+      CHECK(g.position_mm[0][0] == 0.0);
+      CHECK(g.position_mm[0][1] == 0.0);
+      CHECK(g.position_mm[0][2] == 30.0);
+      CHECK(g.orientation[0][3] == 1.0);
+    }
   }
   CHECK(r.status().phase == SequenceStatus::aborted);
   CHECK(std::string(r.status().path) == "aborted");

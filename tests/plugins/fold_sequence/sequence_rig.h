@@ -262,7 +262,9 @@ class Rig {
         a.st.reason = 0;
         a.left = move_cycles;
         a.stall = stalls(s, g, index);
-        if (g.stop_on == ArmGoal::stop_none && g.frame == ArmGoal::sheet && g.position_mm[0][2] < -1) {
+        const bool up = (g.frame == ArmGoal::sheet && g.position_mm[0][2] < -1) ||
+                        (g.frame == ArmGoal::measured && g.position_mm[0][2] > 1);
+        if (g.stop_on == ArmGoal::stop_none && up) {
           contact_[s].in_contact = 0;  // lifting off
           contact_[s].fingers = 0;
         }

@@ -1,0 +1,373 @@
+#include "tools/trials/trial_run.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <thread>
+
+#include <yaml-cpp/yaml.h>
+
+#include "core/config/daemon_config.h"
+#include "core/daemon/daemon.h"
+#include "core/port_types/sequence_status.h"
+#include "core/port_types/sheet_state.h"
+#include "core/port_types/world_state.h"
+#include "plugins/fold_sequence/fold_spec.h"
+#include "plugins/fold_sequence/states.h"
+#include "plugins/robot_model/robot_params.h"
+#include "plugins/sim_world/randomise.h"
+#include "rt/clock.h"
+#include "rt/latest.h"
+
+namespace fs = std::filesystem;
+
+namespace crease::trials {
+namespace {
+
+constexpr double kClearMm = 20.0;        // hands clear: every fingertip at least this high
+constexpr double kTouchN = 0.05;         // a fingertip pressing more than this touches
+constexpr double kAbortWaitS = 90.0;     // the retreat of an operator abort ends within this
+
+template <class T>
+std::unique_ptr<rt::LatestReader<T>> reader(PluginHost& host, const std::string& port) {
+  const rt::LatestChannel* ch = host.ports().find_latest(port);
+  if (ch == nullptr) throw std::runtime_error("the configuration has no port '" + port + "'");
+  return std::make_unique<rt::LatestReader<T>>(ch);
+}
+
+// The world's draws for SEED from the world instance's parameters (as sim_world makes them).
+std::string describe_draws(const config::DaemonConfig& cfg, std::uint64_t seed) {
+  for (const auto& p : cfg.plugins) {
+    if (p.library != "sim_world") continue;
+    world::WorldParams w;
+    w.seed = seed;
+    const YAML::Node& n = p.params;
+    auto num = [&](const char* key, double& v) {
+      if (n[key]) v = n[key].as<double>();
+    };
+    if (n["randomise"]) w.randomise = n["randomise"].as<bool>();
+    num("sheet_offset_mm", w.sheet_offset_mm);
+    num("sheet_yaw_deg", w.sheet_yaw_deg);
+    num("stiffness_fraction", w.stiffness_fraction);
+    num("yield_fraction", w.yield_fraction);
+    num("friction_fraction", w.friction_fraction);
+    const fs::path robot = fs::path(cfg.file).parent_path() / n["robot"].as<std::string>();
+    return world::describe(seed, world::draw_world(w, robot::load_robot_params(robot.string())));
+  }
+  return "no sim_world instance";
+}
+
+std::string world_instance(const config::DaemonConfig& cfg) {
+  for (const auto& p : cfg.plugins)
+    if (p.library == "sim_world") return p.name;
+  throw std::runtime_error("the configuration runs no sim_world: a trial needs the world's truth");
+}
+
+std::string fold_instance(const config::DaemonConfig& cfg) {
+  for (const auto& p : cfg.plugins)
+    if (p.library == "fold_sequence") return p.name;
+  throw std::runtime_error("the configuration runs no fold_sequence");
+}
+
+std::string status_port(const config::DaemonConfig& cfg, const std::string& instance) {
+  for (const auto& p : cfg.plugins)
+    if (p.name == instance) {
+      const auto it = p.ports.find("sequence_status");
+      return it != p.ports.end() ? it->second : "sequence_status";
+    }
+  return "sequence_status";
+}
+
+// The world's hands now: touching anything, their lowest fingertip.
+void hands_now(const WorldState& w, bool& touching, double& min_z) {
+  touching = false;
+  min_z = 1e9;
+  for (const WorldHand& h : w.hand) {
+    touching = touching || h.palm_contact != 0;
+    for (const WorldFingertip& t : h.tip) {
+      touching = touching || t.contact != 0 || t.normal_force_n > kTouchN;
+      min_z = std::min(min_z, double(t.position_mm[2]));
+    }
+  }
+}
+
+}  // namespace
+
+void judge(TrialResult& r) {
+  r.success = false;
+  if (!r.error.empty()) {
+    r.failure = "error: " + r.error;
+  } else if (r.end != "done") {
+    r.failure = r.end == "not_started" ? "not started (the start's guard never passed)"
+                                       : (r.end == "time_limit" ? "time limit in " : "aborted in ") + r.last_fold_state +
+                                             (r.abort_reason.empty() ? "" : ": " + r.abort_reason);
+  } else if (!r.score.shape_ok) {
+    r.failure = r.score.miss;
+  } else if (!r.hands_clear) {
+    r.failure = "a hand not clear of the sheet at the end";
+  } else {
+    r.success = true;
+    r.failure.clear();
+    return;
+  }
+  // A failure whose fold was never made still says what the sheet's truth shows.
+  if (r.error.empty() && !r.score.miss.empty() && r.end != "done") r.failure += "; sheet: " + r.score.miss;
+}
+
+TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
+  TrialResult r;
+  r.index = index;
+  r.seed = seed;
+  r.fold = o.fold;
+  try {
+    fs::create_directories(o.dir);
+    config::DaemonConfig cfg = config::load_daemon_config(o.config);
+    const std::string world = world_instance(cfg), fold = fold_instance(cfg);
+    const std::string fold_file = "folds/" + o.fold + ".yaml";
+    config::override_param(cfg, world + ".seed=" + std::to_string(seed));
+    config::override_param(cfg, fold + ".fold=" + fold_file);
+    const fold::FoldSpec spec = fold::load_fold_file((fs::path(cfg.file).parent_path() / fold_file).string());
+    FoldTarget target;
+    for (int k = 0; k < 2; ++k)
+      for (int c = 0; c < 2; ++c) target.line_mm[k][c] = spec.fold_line_mm[k][c];
+    target.flap_corner_mm[0] = spec.corner_mm[0];
+    target.flap_corner_mm[1] = spec.corner_mm[1];
+    r.draws = describe_draws(cfg, seed);
+    const std::string status_name = status_port(cfg, fold);
+
+    daemon::Options opts;
+    opts.plugin_dirs = o.plugin_dirs;
+    opts.report_dir = o.dir;
+    opts.socket = (fs::path(o.dir) / "creased.sock").string();
+    opts.progress = false;
+    opts.duration_s = o.ready_timeout_s + o.max_fold_s + kAbortWaitS + o.retain_s + 30.0;  // a backstop only
+    daemon::Daemon d(std::move(cfg), opts);
+    PluginHost& host = d.host();
+    auto status = reader<SequenceStatus>(host, status_name);
+    auto world_state = reader<WorldState>(host, "world_state");
+    auto truth = reader<SheetState>(host, "sheet_truth");
+    auto reference = std::make_unique<SheetState>();
+    bool have_reference = false;
+    std::atomic<bool> daemon_ended{false};  // run() returned (or threw) before the supervisor ended it
+
+    // The supervisor: starts the sequence, follows it, takes the truth, ends the run.
+    std::thread supervisor([&] {
+      const std::int64_t t0 = rt::now_ns();
+      auto since = [&](std::int64_t from) { return static_cast<double>(rt::now_ns() - from) * 1e-9; };
+      host.set_param(fold, "command", 1.0);  // creasectl sequence start: taken when the guard passes
+      std::int64_t started_ns = 0, ended_ns = 0;
+      std::uint32_t seen_transitions = 0;
+      std::set<std::string> fold_states;
+      bool operator_abort = false, grasp_reference = false;
+      for (;;) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        if (daemon_ended.load()) {
+          r.end = "error";
+          r.error = "creased stopped before the trial ended";
+          break;
+        }
+        status->poll();
+        const SequenceStatus& s = status->value();
+        if (world_state->poll().has_data()) {
+          for (int h = 0; h < 2; ++h)
+            for (const WorldFingertip& t : world_state->value().hand[h].tip)
+              r.max_force_n[h] = std::max(r.max_force_n[h], double(t.normal_force_n));
+        }
+        if (started_ns == 0 && s.phase != SequenceStatus::idle) {
+          started_ns = rt::now_ns();
+          if (truth->poll().has_data()) {
+            *reference = truth->value();  // the slip's reference until the grasp
+            have_reference = true;
+          }
+        }
+        if (s.transitions != seen_transitions) {
+          seen_transitions = s.transitions;
+          const std::string path(s.path, strnlen(s.path, sizeof s.path));
+          r.timeline.push_back({started_ns != 0 ? since(started_ns) : 0.0, path, std::string(s.why, strnlen(s.why, sizeof s.why))});
+          if (path.rfind("fold/", 0) == 0) {
+            fold_states.insert(path);
+            r.last_fold_state = path;
+          }
+          if (!grasp_reference && path.rfind("fold/grasp", 0) == 0 && truth->poll().has_data()) {
+            *reference = truth->value();  // the shift is over: from here on the base should stay
+            have_reference = grasp_reference = true;
+          }
+        }
+        if (started_ns == 0) {
+          if (since(t0) > o.ready_timeout_s) {
+            r.end = "not_started";
+            break;
+          }
+          continue;
+        }
+        // Aborted once the retreat ended (the phase is `aborted` while it runs, under abort/).
+        const bool retreat_over = std::strncmp(s.path, "aborted", sizeof s.path) == 0;
+        if (s.phase == SequenceStatus::done || (s.phase == SequenceStatus::aborted && retreat_over)) {
+          if (ended_ns == 0) ended_ns = rt::now_ns();
+          const bool retained = s.phase != SequenceStatus::done || since(ended_ns) >= o.retain_s;
+          if (retained && since(ended_ns) >= 0.5) {
+            r.end = s.phase == SequenceStatus::done ? "done" : (operator_abort ? "time_limit" : "aborted");
+            r.abort_reason = s.phase == SequenceStatus::aborted
+                                 ? fold::reason_name(static_cast<fold::Reason>(s.abort_reason))
+                                 : "";
+            r.fold_time_s = static_cast<double>(ended_ns - started_ns) * 1e-9;
+            break;
+          }
+          continue;
+        }
+        if (!operator_abort && since(started_ns) > o.max_fold_s) {
+          host.set_param(fold, "command", 4.0);  // creasectl sequence abort: the safe retreat
+          operator_abort = true;
+        }
+        if (operator_abort && since(started_ns) > o.max_fold_s + kAbortWaitS) {
+          r.end = "time_limit";
+          r.error = "the abort's retreat did not end";
+          break;
+        }
+      }
+      status->poll();
+      r.transitions = status->value().transitions;
+      r.fold_states = static_cast<int>(fold_states.size());
+      if (world_state->poll().has_data()) {
+        bool touching = false;
+        hands_now(world_state->value(), touching, r.min_tip_z_mm);
+        r.hands_clear = !touching && r.min_tip_z_mm >= kClearMm;
+      }
+      // The sheet as it lies now, from a sample taken after the end.
+      const std::int64_t at = rt::now_ns();
+      while (truth->poll().has_data() && truth->value().timestamp_ns < at && since(at) < 2.0)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (truth->poll().has_data())
+        r.score = score_sheet(truth->value(), target, o.bounds, have_reference ? reference.get() : nullptr);
+      d.request_stop();
+    });
+    try {
+      d.run();
+    } catch (...) {
+      daemon_ended.store(true);
+      supervisor.join();
+      throw;
+    }
+    daemon_ended.store(true);
+    supervisor.join();
+    // The exact timeline: every transition the sequence marked (the host's events), sampled
+    // above only as a fallback. Times from its start; the fold's time from start to its end.
+    std::vector<TimelineEntry> marks;
+    std::set<std::string> states;
+    std::int64_t t_start = 0, t_end = 0;
+    std::string last;
+    for (const HostEvent& e : host.events()) {
+      if (e.type != HostEvent::Type::mark || e.instance != fold) continue;
+      const std::size_t colon = e.detail.find(": ");
+      const std::string path = e.detail.substr(0, colon), why = colon == std::string::npos ? "" : e.detail.substr(colon + 2);
+      if (t_start == 0) t_start = e.time_ns;
+      marks.push_back({static_cast<double>(e.time_ns - t_start) * 1e-9, path, why});
+      if (path.rfind("fold/", 0) == 0) {
+        states.insert(path);
+        last = path;
+      }
+      if (path == "aborted" || path == "done") t_end = e.time_ns;
+    }
+    if (!marks.empty()) {
+      r.timeline = std::move(marks);
+      r.fold_states = static_cast<int>(states.size());
+      r.last_fold_state = last;
+      if (t_end != 0) r.fold_time_s = static_cast<double>(t_end - t_start) * 1e-9;
+    }
+  } catch (const std::exception& e) {
+    r.error = e.what();
+    r.end = "error";
+  }
+  judge(r);
+  return r;
+}
+
+namespace {
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+double num(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : std::nan(""); }
+}  // namespace
+
+nlohmann::json to_json(const TrialResult& r) {
+  nlohmann::json timeline = nlohmann::json::array();
+  for (const auto& e : r.timeline) timeline.push_back({{"t_s", e.t_s}, {"path", e.path}, {"why", e.why}});
+  const Score& s = r.score;
+  return {{"trial", r.index},
+          {"seed", r.seed},
+          {"fold", r.fold},
+          {"draws", r.draws},
+          {"end", r.end},
+          {"abort_reason", r.abort_reason},
+          {"last_fold_state", r.last_fold_state},
+          {"fold_states", r.fold_states},
+          {"transitions", r.transitions},
+          {"fold_time_s", r.fold_time_s},
+          {"score",
+           {{"fold_line_mm", num(s.fold_line_mm)},
+            {"fold_angle_deg", num(s.fold_angle_deg)},
+            {"corners_mm", num(s.corners_mm)},
+            {"retained_deg", num(s.retained_deg)},
+            {"max_stretch", num(s.max_stretch)},
+            {"slip_mm", num(s.slip_mm)},
+            {"flap_nodes", s.flap_nodes},
+            {"folded_nodes", s.folded_nodes},
+            {"base_nodes", s.base_nodes},
+            {"torn", s.torn},
+            {"off_table", s.off_table},
+            {"valid", s.valid},
+            {"shape_ok", s.shape_ok},
+            {"miss", s.miss}}},
+          {"hands_clear", r.hands_clear},
+          {"min_tip_z_mm", num(r.min_tip_z_mm)},
+          {"max_force_n", {num(r.max_force_n[0]), num(r.max_force_n[1])}},
+          {"success", r.success},
+          {"failure", r.failure},
+          {"timeline", timeline},
+          {"error", r.error}};
+}
+
+TrialResult from_json(const nlohmann::json& j) {
+  TrialResult r;
+  r.index = j.at("trial").get<int>();
+  r.seed = j.at("seed").get<std::uint64_t>();
+  r.fold = j.at("fold").get<std::string>();
+  r.draws = j.at("draws").get<std::string>();
+  r.end = j.at("end").get<std::string>();
+  r.abort_reason = j.at("abort_reason").get<std::string>();
+  r.last_fold_state = j.at("last_fold_state").get<std::string>();
+  r.fold_states = j.at("fold_states").get<int>();
+  r.transitions = j.at("transitions").get<std::uint32_t>();
+  r.fold_time_s = j.at("fold_time_s").get<double>();
+  const auto& s = j.at("score");
+  r.score.fold_line_mm = num(s.at("fold_line_mm"));
+  r.score.fold_angle_deg = num(s.at("fold_angle_deg"));
+  r.score.corners_mm = num(s.at("corners_mm"));
+  r.score.retained_deg = num(s.at("retained_deg"));
+  r.score.max_stretch = num(s.at("max_stretch"));
+  r.score.slip_mm = num(s.at("slip_mm"));
+  r.score.flap_nodes = s.at("flap_nodes").get<int>();
+  r.score.folded_nodes = s.at("folded_nodes").get<int>();
+  r.score.base_nodes = s.at("base_nodes").get<int>();
+  r.score.torn = s.at("torn").get<bool>();
+  r.score.off_table = s.at("off_table").get<bool>();
+  r.score.valid = s.at("valid").get<bool>();
+  r.score.shape_ok = s.at("shape_ok").get<bool>();
+  r.score.miss = s.at("miss").get<std::string>();
+  r.hands_clear = j.at("hands_clear").get<bool>();
+  r.min_tip_z_mm = num(j.at("min_tip_z_mm"));
+  r.max_force_n[0] = num(j.at("max_force_n")[0]);
+  r.max_force_n[1] = num(j.at("max_force_n")[1]);
+  r.success = j.at("success").get<bool>();
+  r.failure = j.at("failure").get<std::string>();
+  for (const auto& e : j.at("timeline"))
+    r.timeline.push_back({e.at("t_s").get<double>(), e.at("path").get<std::string>(), e.at("why").get<std::string>()});
+  r.error = j.at("error").get<std::string>();
+  return r;
+}
+
+}  // namespace crease::trials

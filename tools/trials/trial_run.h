@@ -1,0 +1,71 @@
+// One folding trial of crease-trials: the simulated robot of a configuration (config/sim.yaml:
+// the world with its devices, the drivers over the mocked buses, cameras, vision, the sheet
+// model, the controllers and the folding sequence) run by creased's own body (core/daemon) in
+// this process, the world drawn from the trial's seed. The sequence is started (as
+// `creasectl sequence start` does), followed to done or aborted (an operator abort at the
+// trial's time limit), and the trial scored from the world's truth (`sheet_truth`,
+// `world_state`), never from the tracked model. Non-RT; one trial per process (the loops,
+// buses and plugins are the process's).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "tools/trials/trial_score.h"
+
+namespace crease::trials {
+
+struct TrialOptions {
+  std::string config;                    // the configuration file (sim.yaml)
+  std::vector<std::string> plugin_dirs;  // empty: the configuration's
+  std::string fold = "half";             // the sequence file folds/<fold>.yaml beside the configuration
+  double max_fold_s = 300;               // from the sequence's start; then the operator's abort
+  double ready_timeout_s = 60;           // the start waits for its guard at most this long
+  double retain_s = 5;                   // after done (the hands released): then the retained angle
+  std::string dir;                       // the trial's directory: its report, log, socket
+  Bounds bounds;
+};
+
+struct TimelineEntry {
+  double t_s = 0;  // since the sequence's start
+  std::string path, why;
+};
+
+struct TrialResult {
+  int index = 0;
+  std::uint64_t seed = 0;
+  std::string fold;
+  std::string draws;         // what the seed drew (the world's randomisation)
+  // How the sequence ended: done, aborted (by a fault, the reason below), time_limit (the
+  // trial's operator abort), not_started (its start guard never passed), error.
+  std::string end;
+  std::string abort_reason;  // fold_sequence's reason name, "" when none
+  std::string last_fold_state;  // the deepest state of the fold reached (before any abort)
+  int fold_states = 0;       // distinct states of the fold entered (states of abort not counted)
+  std::uint32_t transitions = 0;
+  double fold_time_s = 0;    // from the start to done or aborted
+  Score score;
+  bool hands_clear = false;  // at the end (world truth): no fingertip or palm touching, every tip 20 mm up or more
+  double min_tip_z_mm = 0;
+  double max_force_n[2] = {0, 0};  // the largest fingertip normal force of each hand over the trial
+  bool success = false;
+  std::string failure;       // the first reason it is not a success ("" for a success)
+  std::vector<TimelineEntry> timeline;
+  std::string error;
+};
+
+// Runs one trial in this process (see above). Never throws: a configuration or start-up error
+// is the result's `error` (end "error").
+[[nodiscard]] TrialResult run_trial(const TrialOptions& options, int index, std::uint64_t seed);
+
+// Whether the trial succeeded, and why not: the sequence done, the sheet's shape within the
+// bounds, not torn, on the table, the hands clear.
+void judge(TrialResult& r);
+
+[[nodiscard]] nlohmann::json to_json(const TrialResult& r);
+[[nodiscard]] TrialResult from_json(const nlohmann::json& j);
+
+}  // namespace crease::trials
