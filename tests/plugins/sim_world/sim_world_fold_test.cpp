@@ -13,7 +13,8 @@
 // elbow stretches straight before the pinch has turned 60 deg; carried away from the robot
 // (the near edge over to the far one) the turning hand's wrist moves away from the shoulder and
 // the elbow straightens too, at any table height tried (0-400 mm).
-// Failing variant: frictionless fingers: the pinch loses the edge at ~60 deg and it falls back.
+// Failing variants: frictionless fingers: the pinch loses the edge at ~60 deg and it falls back;
+// the left index not pressing: the pinch drags the near half after it.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -137,7 +138,8 @@ double near_edge_y(const World& w) {
   return y / g.w;
 }
 
-Fold fold(WorldParams p, Bimanual& b) {
+// FIXATE false: the left index hovers 8 mm over the near half instead of pressing it.
+Fold fold(WorldParams p, Bimanual& b, bool fixate = true) {
   p.sheet.grid.origin_mm.y += kSheetDyMm;
   p.table_height_mm = kTableMm;
   p.table_extent_mm = {-WorldParams::kNoEdge, WorldParams::kNoEdge, -WorldParams::kNoEdge, 95.0 + kSheetDyMm};
@@ -157,12 +159,12 @@ Fold fold(WorldParams p, Bimanual& b) {
   b.start();
   b.hold(0.3);
   // The left index down to contact at 10 mm/s, then 8 mm further (0.76 N).
-  while (b.l.at.z > kTableMm - 3 && b.hand(Side::left).tip[0].contact == 0) {
+  while (fixate && b.l.at.z > kTableMm - 3 && b.hand(Side::left).tip[0].contact == 0) {
     b.l.at.z -= 0.01;
     b.step();
   }
   const double zc = b.l.at.z;
-  while (b.l.at.z > zc - 8) {
+  while (fixate && b.l.at.z > zc - 8) {
     b.l.at.z -= 0.01;
     b.step();
   }
@@ -234,4 +236,11 @@ TEST_CASE("the hands fold the sheet in half: one pinches the far edge and lays i
   const Fold lost = fold(slippery, b0);
   print("frictionless fingers", lost);
   CHECK_FALSE(folded(lost));
+
+  Bimanual b1;
+  const Fold loose = fold(nominal(), b1, false);
+  print("no fixation", loose);
+  CHECK_FALSE(f.near_drag_mm >= 10.0);
+  CHECK(loose.near_drag_mm >= 10.0);  // the pinch drags the unheld sheet after it
+  CHECK_FALSE(folded(loose));
 }
