@@ -64,8 +64,29 @@ class ArmIk {
 
   // Arm angles putting link TOOL's origin (without prefix) at p_mm with the palm turned to
   // PALM, the hand at HAND, starting from GUESS. Fails the test when the solver does not reach
-  // it within 0.01 mm or leaves a joint's limits.
-  ArmQ solve(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess) {
+  // it within TOL_MM (0.01 mm) or leaves a joint's limits.
+  ArmQ solve(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess,
+             double tol_mm = 0.01) {
+    const Attempt a = attempt(tool, p_mm, palm, hand, guess);
+    if (!(a.err_mm < tol_mm)) std::printf("ik: rc %d err %.4f mm\n", a.rc, a.err_mm);
+    REQUIRE(a.err_mm < tol_mm);
+    for (int i = 0; i < robot::kArmJoints; ++i) {
+      REQUIRE(a.q[i] >= lo_[i]);
+      REQUIRE(a.q[i] <= hi_[i]);
+    }
+    return a.q;
+  }
+
+  // The solver's answer without failing the test: the angles (a joint past a limit turned by
+  // 2 pi when that brings it within), how far the tool ended from the goal, and whether every
+  // joint is within its limits.
+  struct Attempt {
+    ArmQ q{};
+    double err_mm = 0;
+    bool within_limits = false;
+    int rc = 0;
+  };
+  Attempt attempt(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess) {
     const int t = kin_->link_index(prefix_ + tool), pl = kin_->link_index(prefix_ + "palm");
     REQUIRE(t >= 0);
     kin_->update_rt(guess, hand);
@@ -76,19 +97,21 @@ class ArmIk {
     const KDL::Frame goal = KDL::Frame(palm, p) * palm_flange;
     KDL::JntArray q0(robot::kArmJoints), q(robot::kArmJoints);
     for (int i = 0; i < robot::kArmJoints; ++i) q0(i) = guess[i];
-    const int rc = solver_->CartToJnt(q0, goal, q);
-    ArmQ out{};
-    for (int i = 0; i < robot::kArmJoints; ++i) out[i] = q(i);
+    Attempt a;
+    a.rc = solver_->CartToJnt(q0, goal, q);
+    a.within_limits = true;
+    for (int i = 0; i < robot::kArmJoints; ++i) {
+      double v = q(i);
+      constexpr double kTurn = 2.0 * std::numbers::pi;
+      if (v > hi_[i] && v - kTurn >= lo_[i]) v -= kTurn;
+      if (v < lo_[i] && v + kTurn <= hi_[i]) v += kTurn;
+      a.q[i] = v;
+      a.within_limits = a.within_limits && v >= lo_[i] && v <= hi_[i];
+    }
     KDL::Frame reached;
     REQUIRE(fk_->JntToCart(q, reached) >= 0);
-    const double err_mm = 1000.0 * (reached.p - goal.p).Norm();
-    if (!(err_mm < 0.01)) std::printf("ik: rc %d err %.4f mm\n", rc, err_mm);
-    REQUIRE(err_mm < 0.01);
-    for (int i = 0; i < robot::kArmJoints; ++i) {
-      REQUIRE(out[i] >= lo_[i]);
-      REQUIRE(out[i] <= hi_[i]);
-    }
-    return out;
+    a.err_mm = 1000.0 * (reached.p - goal.p).Norm();
+    return a;
   }
 
  private:
