@@ -61,7 +61,7 @@ class DdsBridge final : public crease::Plugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     const std::string xml = p.get_path("dds_config", "dds/loopback.xml");
-    const int domain = p.get_in_range<int>("domain", -1, 0, Participant::kMaxDomainId);
+    const int domain = p.has("domain") ? p.get_in_range<int>("domain", 0, 0, Participant::kMaxDomainId) : -1;
     const int priority = p.get_in_range<int>("thread_priority", 0, 0, 98);
     // The domain: `domain` when given (it must be the one the XML names, if it names one), else
     // the XML's, else 0. The file's errors (crease::Error, naming it) are the parameter's.

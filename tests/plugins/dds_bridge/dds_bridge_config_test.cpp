@@ -79,6 +79,9 @@ TEST_CASE("entries: unknown type or port, a type mismatch, a port with another w
               "publish[0].view", "a keypoints port has no joints (joint_state views: hand_state, arm_state)"));
   CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, joint_prefix: r_}]}"),
               "publish[0].joint_prefix", "only with view: joint_state"));
+  // No domain: the XML's (dds/loopback.xml says any: domain 0), as config/split/ runs.
+  CHECK(error_of(h, "{publish: [{port: hand_state, topic: " + crease::test::test_topic("no_domain") + "}]}") ==
+        "no error");
   // Nothing was left behind by the refusals: a good entry binds the same ports.
   CHECK(error_of(h, d() + "publish: [{port: hand_state, topic: a}], subscribe: [{topic: b, port: hand_state_2, type: "
                           "hand_state}]}") == "no error");
