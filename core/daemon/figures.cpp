@@ -47,8 +47,13 @@ std::string progress_text(const std::vector<FigureReading>& figures) {
   for (const FigureReading& r : figures) {
     if (r.figure.count == 0) continue;
     char buf[256];
-    std::snprintf(buf, sizeof(buf), "; %s: %.2f %s (this second), %.2f %s (mean so far)", r.figure.label,
-                  r.window_mean, r.figure.unit, r.figure.mean(), r.figure.unit);
+    if (r.window_count == 0) {  // no sample this second (its source paused or gone): no figure for it
+      std::snprintf(buf, sizeof(buf), "; %s: no %s (this second), %.2f %s (mean so far)", r.figure.label,
+                    r.figure.sample, r.figure.mean(), r.figure.unit);
+    } else {
+      std::snprintf(buf, sizeof(buf), "; %s: %.2f %s (this second), %.2f %s (mean so far)", r.figure.label,
+                    r.window_mean, r.figure.unit, r.figure.mean(), r.figure.unit);
+    }
     out += buf;
   }
   return out;

@@ -8,7 +8,10 @@
 //                      (default 0: SCHED_OTHER; Cyclone's own threads take theirs from the XML)
 //   publish:   [{port: P, topic: T, type: K, <QoS>}]   each new value of port P -> DDS topic rt/T
 //   subscribe: [{topic: T, port: P, type: K, <QoS>}]   samples of rt/T -> port P (this bridge writes it)
-//   type: keypoints | hand_state | hand_command   (optional when port P is already bound: its type)
+//   type: keypoints | hand_state | hand_command | arm_state | arm_command | sheet_state
+//                      (optional when port P is already bound: its type)
+//   view: joint_state  publish entries of hand_state and arm_state ports: as sensor_msgs/msg/JointState,
+//   joint_prefix: r_   its joints named prefix + the URDF's names (joint_state_view.h)
 //   QoS keys: reliability, depth, deadline_ms, liveliness_ms (topic_qos.h)
 // Ports: the configured ones, and `<instance>_stats` (crease::BridgeStats), its counters.
 // Status: degraded while a subscribed topic is stale (never heard, its publisher lost or late).
@@ -58,7 +61,7 @@ class DdsBridge final : public crease::Plugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     const std::string xml = p.get_path("dds_config", "dds/loopback.xml");
-    const int domain = p.get_in_range<int>("domain", -1, 0, Participant::kMaxDomainId);
+    const int domain = p.has("domain") ? p.get_in_range<int>("domain", 0, 0, Participant::kMaxDomainId) : -1;
     const int priority = p.get_in_range<int>("thread_priority", 0, 0, 98);
     // The domain: `domain` when given (it must be the one the XML names, if it names one), else
     // the XML's, else 0. The file's errors (crease::Error, naming it) are the parameter's.
@@ -157,8 +160,21 @@ class DdsBridge final : public crease::Plugin {
     if (!topics.insert(topic).second) e.fail("topic", "bridged twice by this instance: " + topic);
     const TopicQos qos = parse_qos(e);
     const PayloadKind& kind = kind_of(e, ports, port);
+    // `view: joint_state` (publish only): the port as sensor_msgs/msg/JointState.
+    const std::string view = e.get<std::string>("view", "");
+    if (e.has("view")) {
+      if (!publish) e.fail("view", "a view is published only (a JointState lacks what a hand_state or arm_state port holds)");
+      if (view != "joint_state") e.fail("view", "unknown view '" + view + "' (the bridge has joint_state)");
+      if (kind.make_joint_state == nullptr)
+        e.fail("view", std::string("a ") + kind.key + " port has no joints (joint_state views: " + joint_state_kind_keys() + ")");
+    } else if (e.has("joint_prefix")) {
+      e.fail("joint_prefix", "only with view: joint_state");
+    }
+    const std::string prefix = e.get<std::string>("joint_prefix", "");
     try {
-      if (publish) {
+      if (publish && !view.empty()) {
+        publish_.push_back(kind.make_joint_state(ports, port, participant_->handle(), topic, qos, prefix));
+      } else if (publish) {
         publish_.push_back(kind.make_publish(ports, port, participant_->handle(), topic, qos));
       } else {
         subscribe_.push_back(kind.make_subscribe(ports, port, participant_->handle(), topic, qos));

@@ -1,5 +1,6 @@
 // The links of a bridge: one per configured entry, between a local latest port and a DDS
-// endpoint, typed by the port payload T (keypoints_mirror.h, hand_mirror.h give Dds<T>).
+// endpoint, typed by the port payload T (keypoints_mirror.h, hand_mirror.h, arm_mirror.h,
+// sheet_mirror.h give Dds<T>; joint_state_view.h a publish-only view).
 //
 // Each link owns a lock-free rt::LatestChannel between the RT side and its non-RT side:
 //   publish:   RT write phase: port -> channel (take_rt); publisher thread: channel -> dds_write
@@ -107,15 +108,16 @@ void take_writer_statuses(dds_entity_t writer, LinkCounters& c);
 template <class T, class D>
 class PublishLinkT final : public PublishLink {
  public:
+  // D: the wire form (Dds<T>, or a view such as JointStateView<T>); `scratch` its storage.
   PublishLinkT(PortBinder& ports, const std::string& port, dds_entity_t participant, const std::string& topic,
-               const TopicQos& qos)
+               const TopicQos& qos, std::unique_ptr<typename D::Scratch> scratch = std::make_unique<typename D::Scratch>())
       : PublishLink(topic),
         in_(ports.latest_input<T>(port)),
         channel_(sizeof(T)),
         reader_(&channel_),
         endpoint_(participant, D::descriptor(), topic, qos, true),
         sample_(std::make_unique<typename D::C>()),
-        scratch_(std::make_unique<typename D::Scratch>()) {}
+        scratch_(std::move(scratch)) {}
 
   bool take_rt() noexcept override {
     const rt::ReadInfo info = in_.poll();
@@ -158,7 +160,7 @@ class SubscribeLinkT final : public SubscribeLink {
   SubscribeLinkT(PortBinder& ports, const std::string& port, dds_entity_t participant, const std::string& topic,
                  const TopicQos& qos)
       : SubscribeLink(topic),
-        out_(ports.latest_output<T>(port, T{})),
+        out_(ports.latest_output<T>(port, *std::make_unique<T>())),  // safe value T{} (off the stack: a sheet is 164 kB)
         channel_(sizeof(T)),
         reader_(&channel_),
         endpoint_(participant, D::descriptor(), topic, qos, false),

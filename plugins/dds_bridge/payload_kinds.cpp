@@ -2,8 +2,11 @@
 
 #include <cstring>
 
+#include "arm_mirror.h"
 #include "hand_mirror.h"
+#include "joint_state_view.h"
 #include "keypoints_mirror.h"
+#include "sheet_mirror.h"
 
 namespace crease::dds_bridge {
 
@@ -12,7 +15,7 @@ namespace {
 template <class T>
 PayloadKind kind_of() {
   using D = Dds<T>;
-  return PayloadKind{
+  PayloadKind k{
       D::kKey, port_type_of<T>(), D::descriptor()->m_typename,
       [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
          const TopicQos& qos) -> std::unique_ptr<PublishLink> {
@@ -21,11 +24,22 @@ PayloadKind kind_of() {
       [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
          const TopicQos& qos) -> std::unique_ptr<SubscribeLink> {
         return std::make_unique<SubscribeLinkT<T, D>>(ports, port, pp, topic, qos);
-      }};
+      },
+      nullptr};
+  if constexpr (requires { Joints<T>::kCount; }) {
+    k.make_joint_state = [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
+                            const TopicQos& qos, const std::string& prefix) -> std::unique_ptr<PublishLink> {
+      using V = JointStateView<T>;
+      return std::make_unique<PublishLinkT<T, V>>(ports, port, pp, topic, qos,
+                                                  std::make_unique<typename V::Scratch>(prefix));
+    };
+  }
+  return k;
 }
 
 const PayloadKind kKinds[] = {kind_of<crease::Keypoints>(), kind_of<crease::HandState>(),
-                              kind_of<crease::HandCommand>()};
+                              kind_of<crease::HandCommand>(), kind_of<crease::ArmState>(),
+                              kind_of<crease::ArmCommand>(), kind_of<crease::SheetState>()};
 
 }  // namespace
 
@@ -46,6 +60,13 @@ const PayloadKind* find_payload_kind(const std::string& port_type, std::uint32_t
 std::string payload_kind_keys() {
   std::string s;
   for (const PayloadKind& k : kKinds) s += (s.empty() ? "" : ", ") + std::string(k.key);
+  return s;
+}
+
+std::string joint_state_kind_keys() {
+  std::string s;
+  for (const PayloadKind& k : kKinds)
+    if (k.make_joint_state != nullptr) s += (s.empty() ? "" : ", ") + std::string(k.key);
   return s;
 }
 

@@ -5,6 +5,11 @@
 //   keypoints     crease::Keypoints     crease_msgs::msg::dds_::Keypoints_   (crease_msgs/msg/Keypoints)
 //   hand_state    crease::HandState     crease_msgs::msg::dds_::HandState_   (crease_msgs/msg/HandState)
 //   hand_command  crease::HandCommand   crease_msgs::msg::dds_::HandCommand_ (crease_msgs/msg/HandCommand)
+//   arm_state     crease::ArmState      crease_msgs::msg::dds_::ArmState_    (crease_msgs/msg/ArmState)
+//   arm_command   crease::ArmCommand    crease_msgs::msg::dds_::ArmCommand_  (crease_msgs/msg/ArmCommand)
+//   sheet_state   crease::SheetState    crease_msgs::msg::dds_::SheetState_  (crease_msgs/msg/SheetState)
+// hand_state and arm_state also publish as sensor_msgs/msg/JointState (`view: joint_state`,
+// joint_state_view.h).
 #pragma once
 
 #include <memory>
@@ -25,13 +30,20 @@ struct PayloadKind {
   std::unique_ptr<SubscribeLink> (*make_subscribe)(PortBinder& ports, const std::string& port,
                                                    dds_entity_t participant, const std::string& topic,
                                                    const TopicQos& qos);
+  // The port published as sensor_msgs/msg/JointState, its joints named joint_prefix + the URDF's
+  // names; nullptr for a payload without joints.
+  std::unique_ptr<PublishLink> (*make_joint_state)(PortBinder& ports, const std::string& port,
+                                                   dds_entity_t participant, const std::string& topic,
+                                                   const TopicQos& qos, const std::string& joint_prefix);
 };
 
 [[nodiscard]] std::span<const PayloadKind> payload_kinds();
 // By `type:` key, or by the port's payload type name and version; nullptr when none.
 [[nodiscard]] const PayloadKind* find_payload_kind(const std::string& key);
 [[nodiscard]] const PayloadKind* find_payload_kind(const std::string& port_type, std::uint32_t version);
-// "keypoints, hand_state, hand_command" for messages.
+// "keypoints, hand_state, ..." for messages.
 [[nodiscard]] std::string payload_kind_keys();
+// "hand_state, arm_state": the kinds with a JointState view.
+[[nodiscard]] std::string joint_state_kind_keys();
 
 }  // namespace crease::dds_bridge

@@ -7,6 +7,8 @@
 #include <map>
 #include <string>
 
+#include <yaml-cpp/yaml.h>
+
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
 #include "core/plugin_host.h"
@@ -57,6 +59,35 @@ TEST_CASE("config/sim.yaml: every plugin's steady-state cycles allocate nothing"
     CHECK(i.state == crease::RunState::active);  // no plugin faulted on the way
     CHECK(i.stats->updates.load() > 0);
   }
+}
+
+TEST_CASE("config/split/control.yaml and config/split/vision.yaml validate: the split of config/sim.yaml") {
+  // Their loops and cycles run in tests/config/split_cycles_test.cpp (over DDS: label hil).
+  const auto control = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/split/control.yaml");
+  const auto vision = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/split/vision.yaml");
+  const auto sim = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/sim.yaml");
+  // Every instance of config/sim.yaml runs in one of the two, of the same library and loop
+  // rate, and with the same parameters but for the paths (one folder deeper here).
+  for (const auto& p : sim.plugins) {
+    CAPTURE(p.name);
+    const auto* c = control.find_plugin(p.name);
+    const auto* v = vision.find_plugin(p.name);
+    REQUIRE((c != nullptr) != (v != nullptr));
+    const auto& split = c != nullptr ? *c : *v;
+    CHECK(split.library == p.library);
+    CHECK(split.order == p.order);
+    CHECK(split.ports == p.ports);
+    std::map<std::string, std::string> a, b;
+    for (const auto& kv : p.params) a[kv.first.as<std::string>()] = YAML::Dump(kv.second);
+    for (const auto& kv : split.params) b[kv.first.as<std::string>()] = YAML::Dump(kv.second);
+    for (auto& [k, val] : b)
+      if (val.rfind("../", 0) == 0) val = val.substr(3);  // one folder deeper
+    CHECK(a == b);
+  }
+  // The world, drivers and controllers in control; cameras, vision and model in vision.
+  for (const char* n : {"world", "hand_r", "hand_l", "arm_r", "arm_l", "contact_r", "force_r", "motion_r", "score"})
+    CHECK(control.find_plugin(n) != nullptr);
+  for (const char* n : {"cameras", "vision", "sheet"}) CHECK(vision.find_plugin(n) != nullptr);
 }
 
 TEST_CASE("config/robot.yaml validates (its plugins need the hardware to configure)") {

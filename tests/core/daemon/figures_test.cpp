@@ -31,5 +31,7 @@ TEST_CASE("every Figure port is read, with its mean since the previous take, and
   CHECK(r[0].window_mean == doctest::Approx(6.0));
   CHECK(crease::daemon::progress_text(r) == "; tracking error: 6.00 mm (this second), 3.33 mm (mean so far)");
   CHECK(crease::daemon::summary_text(r) == "  tracking error: mean 3.33 mm over 6 frames, last 2.00 mm, worst 3.00 mm\n");
-  CHECK(watch.take()[0].window_count == 0);  // nothing new since
+  r = watch.take();
+  CHECK(r[0].window_count == 0);  // nothing new since: no figure for this second, not 0 mm
+  CHECK(crease::daemon::progress_text(r) == "; tracking error: no frames (this second), 3.33 mm (mean so far)");
 }

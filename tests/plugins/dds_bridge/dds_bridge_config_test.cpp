@@ -44,7 +44,8 @@ TEST_CASE("entries: unknown type or port, a type mismatch, a port with another w
   BridgeHost h;
   h.add("source", "crease_test_payload_source", 0, "{}");  // writes hand_state (crease.HandState)
   CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: p, type: hand_stat}]}"), "subscribe[0].type",
-              "unknown type 'hand_stat' (the bridge carries keypoints, hand_state, hand_command)"));
+              "unknown type 'hand_stat' (the bridge carries keypoints, hand_state, hand_command, arm_state, "
+              "arm_command, sheet_state)"));
   CHECK(names(error_of(h, d() + "publish: [{port: nothing, topic: a}]}"), "publish[0].port",
               "unknown port 'nothing': no plugin configured before this bridge binds it"));
   CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, type: keypoints}]}"), "publish[0].type",
@@ -69,6 +70,18 @@ TEST_CASE("entries: unknown type or port, a type mismatch, a port with another w
   CHECK(names(error_of(h, d() + "publish: [{port: hand_state}]}"), "publish[0].topic", "required parameter is missing"));
   CHECK(names(error_of(h, d() + "publish: {port: hand_state}}"), "publish", "expected a list of maps"));
   CHECK(names(error_of(h, "{domain: 7}"), "", "nothing to bridge"));
+  // Views: publish only, of ports with joints, known by name; joint_prefix only with one.
+  CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: q, type: hand_state, view: joint_state}]}"),
+              "subscribe[0].view", "a view is published only"));
+  CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, view: ros}]}"), "publish[0].view",
+              "unknown view 'ros' (the bridge has joint_state)"));
+  CHECK(names(error_of(h, d() + "publish: [{port: kp, topic: a, type: keypoints, view: joint_state}]}"),
+              "publish[0].view", "a keypoints port has no joints (joint_state views: hand_state, arm_state)"));
+  CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, joint_prefix: r_}]}"),
+              "publish[0].joint_prefix", "only with view: joint_state"));
+  // No domain: the XML's (dds/loopback.xml says any: domain 0), as config/split/ runs.
+  CHECK(error_of(h, "{publish: [{port: hand_state, topic: " + crease::test::test_topic("no_domain") + "}]}") ==
+        "no error");
   // Nothing was left behind by the refusals: a good entry binds the same ports.
   CHECK(error_of(h, d() + "publish: [{port: hand_state, topic: a}], subscribe: [{topic: b, port: hand_state_2, type: "
                           "hand_state}]}") == "no error");

@@ -1,14 +1,17 @@
 // The copies between port payloads and their IDL's C structs (hand_mirror.h,
-// keypoints_mirror.h): a round trip keeps every field; the checks on the way in refuse
-// non-finite and out-of-range values and more key-points than the payload holds.
+// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h): a round trip keeps every field; the checks
+// on the way in refuse non-finite and out-of-range values, inconsistent lengths and more
+// entries than the payload holds.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <cstring>
 #include <memory>
 
+#include "arm_mirror.h"
 #include "hand_mirror.h"
 #include "keypoints_mirror.h"
+#include "sheet_mirror.h"
 
 using namespace crease;
 using crease::dds_bridge::Dds;
@@ -89,4 +92,121 @@ TEST_CASE("keypoints: only `count` points travel; out-of-range and oversized sam
   CHECK(Dds<Keypoints>::from_dds(*c, *back) == SampleCheck::malformed);
   c->points._length = Keypoints::kCapacity + 1;
   CHECK(Dds<Keypoints>::from_dds(*c, *back) == SampleCheck::oversized);
+}
+
+TEST_CASE("arm_state and arm_command: a round trip keeps every field; bad values are refused") {
+  ArmState s;
+  s.timestamp_ns = 987654321;
+  s.device_time_us = 17;
+  s.valid = 0x5b;
+  s.drive_state = 4;
+  s.error_code = 0x2310;
+  for (int j = 0; j < ArmState::kJoints; ++j) {
+    s.position_rad[j] = 0.2f * j - 0.5f;
+    s.velocity_rad_s[j] = -0.05f * j;
+  }
+  s.fresh = 1;
+  s.health = DeviceHealth::ok;
+  s.safe_state = 0;
+  s.acked_seq = 65000;
+  s.commands_sent = 1ull << 35;
+  s.commands_failed = 9;
+  Dds<ArmState>::C c{};
+  Dds<ArmState>::Scratch scratch;
+  Dds<ArmState>::to_dds(s, c, scratch);
+  ArmState back;
+  REQUIRE(Dds<ArmState>::from_dds(c, back) == SampleCheck::ok);
+#define SAME_FIELD(f) CHECK(std::memcmp(&back.f, &s.f, sizeof(s.f)) == 0);
+  CREASE_ARM_STATE_FIELDS(SAME_FIELD, SAME_FIELD)
+#undef SAME_FIELD
+  c.health = 3;
+  CHECK(Dds<ArmState>::from_dds(c, back) == SampleCheck::malformed);
+  c.health = 0;
+  c.valid = 0x80;  // an eighth joint
+  CHECK(Dds<ArmState>::from_dds(c, back) == SampleCheck::malformed);
+  c.valid = 0x7f;
+  c.velocity_rad_s[6] = -INFINITY;
+  CHECK(Dds<ArmState>::from_dds(c, back) == SampleCheck::malformed);
+
+  ArmCommand cmd;
+  cmd.timestamp_ns = 12;
+  cmd.mode = ArmCommand::velocity;
+  cmd.position_rad[6] = -1.25f;
+  cmd.velocity_rad_s[0] = 0.5f;
+  Dds<ArmCommand>::C cc{};
+  Dds<ArmCommand>::Scratch cs;
+  Dds<ArmCommand>::to_dds(cmd, cc, cs);
+  ArmCommand cmd_back;
+  REQUIRE(Dds<ArmCommand>::from_dds(cc, cmd_back) == SampleCheck::ok);
+#define SAME_FIELD(f) CHECK(std::memcmp(&cmd_back.f, &cmd.f, sizeof(cmd.f)) == 0);
+  CREASE_ARM_COMMAND_FIELDS(SAME_FIELD, SAME_FIELD)
+#undef SAME_FIELD
+  cc.mode = 2;
+  CHECK(Dds<ArmCommand>::from_dds(cc, cmd_back) == SampleCheck::malformed);
+  cc.mode = 0;
+  cc.position_rad[2] = NAN;
+  CHECK(Dds<ArmCommand>::from_dds(cc, cmd_back) == SampleCheck::malformed);
+}
+
+TEST_CASE("sheet_state: only the valid nodes, creases and links travel; inconsistent or oversized samples are refused") {
+  auto s = std::make_unique<SheetState>();
+  s->timestamp_ns = 5;
+  s->step = 77;
+  s->nodes_u = 3;
+  s->nodes_v = 2;
+  s->width_mm = 210;
+  s->height_mm = 297;
+  s->link_count = 4;
+  s->crease_count = 2;
+  s->fit_error_mm = 0.75f;
+  s->observations = 40;
+  s->rollbacks = 1;
+  for (int i = 0; i < 6; ++i)
+    for (int c = 0; c < 3; ++c) {
+      s->position_mm[i][c] = 10.0f * i + c;
+      s->normal[i][c] = c == 2 ? 1.0f : 0.0f;
+    }
+  for (int k = 0; k < 2; ++k) {
+    for (int c = 0; c < 4; ++c) s->crease_mm[k][c] = 100.0f * k + c;
+    s->crease_id[k] = 40 + k;
+  }
+  for (int l = 0; l < 4; ++l) s->strain[l] = 0.001f * l;
+  s->strain[4] = NAN;  // beyond link_count: not carried, not checked
+  auto c = std::make_unique<Dds<SheetState>::C>();
+  Dds<SheetState>::Scratch scratch;
+  Dds<SheetState>::to_dds(*s, *c, scratch);
+  CHECK(c->position_mm._length == 18);
+  CHECK(c->normal._length == 18);
+  CHECK(c->crease_mm._length == 8);
+  CHECK(c->crease_id._length == 2);
+  CHECK(c->strain._length == 4);
+  auto back = std::make_unique<SheetState>();
+  REQUIRE(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::ok);
+#define SAME_FIELD(f) CHECK(std::memcmp(&back->f, &s->f, sizeof(s->f)) == 0);
+  CREASE_SHEET_STATE_HEADER_FIELDS(SAME_FIELD, SAME_FIELD)
+#undef SAME_FIELD
+  CHECK(back->link_count == 4);
+  CHECK(back->crease_count == 2);
+  CHECK(std::memcmp(back->position_mm, s->position_mm, 6 * 3 * sizeof(float)) == 0);
+  CHECK(std::memcmp(back->normal, s->normal, 6 * 3 * sizeof(float)) == 0);
+  CHECK(std::memcmp(back->crease_mm, s->crease_mm, 2 * 4 * sizeof(float)) == 0);
+  CHECK(back->crease_id[1] == 41);
+  CHECK(std::memcmp(back->strain, s->strain, 4 * sizeof(float)) == 0);
+
+  // Lengths that do not fit the grid or each other; a non-finite node; more than the payload holds.
+  c->position_mm._length = 15;
+  CHECK(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::malformed);
+  c->position_mm._length = 18;
+  c->crease_mm._length = 4;
+  CHECK(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::malformed);
+  c->crease_mm._length = 8;
+  s->position_mm[5][1] = INFINITY;
+  CHECK(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::malformed);
+  s->position_mm[5][1] = 0;
+  c->strain._length = SheetState::kMaxLinks + 1;
+  CHECK(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::oversized);
+  c->strain._length = 4;
+  c->nodes_u = 65;
+  c->nodes_v = 64;  // 4160 nodes: more than kMaxNodes
+  CHECK(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::oversized);
 }
