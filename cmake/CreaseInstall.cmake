@@ -42,7 +42,9 @@ install(TARGETS crease_rt crease_frames crease_core EXPORT CreaseTargets
 # --- configurations. The installed copies name the installed plugin directory instead of the
 # build tree's and write no report unless asked (--report-dir): the installed tree is read-only.
 set(installed_config ${CMAKE_BINARY_DIR}/installed-config)
-file(GLOB config_yamls RELATIVE ${CMAKE_SOURCE_DIR}/config ${CMAKE_SOURCE_DIR}/config/*.yaml)
+# config/*.yaml and the split's config/split/*.yaml (one folder deeper: one more ../).
+file(GLOB config_yamls RELATIVE ${CMAKE_SOURCE_DIR}/config ${CMAKE_SOURCE_DIR}/config/*.yaml
+     ${CMAKE_SOURCE_DIR}/config/split/*.yaml)
 foreach(y ${config_yamls})
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/config/${y})
   file(READ ${CMAKE_SOURCE_DIR}/config/${y} text)
@@ -52,7 +54,7 @@ foreach(y ${config_yamls})
 endforeach()
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/config/ DESTINATION ${CREASE_INSTALL_DATADIR}/config COMPONENT runtime
         FILE_PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ
-        PATTERN "creased.service" EXCLUDE REGEX "/config/[^/]*\\.yaml$" EXCLUDE)
+        PATTERN "creased.service" EXCLUDE REGEX "/config/(split/)?[^/]*\\.yaml$" EXCLUDE)
 # The robot's own configuration goes to /etc/crease with what it reads (cameras, markers, robot).
 set(CREASE_ETC_SUBDIRS cameras markers robot dds)  # what robot.yaml reads; conffiles too
 foreach(sub ${CREASE_ETC_SUBDIRS})
@@ -68,7 +70,11 @@ install(CODE "
   file(REMOVE_RECURSE \"\${out}\")
   foreach(y ${config_yamls})
     file(READ \"${installed_config}/\${y}.in\" text)
-    string(REPLACE \"@CREASE_PLUGIN_DIRS@\" \"../../../${CREASE_INSTALL_PLUGINDIR}\" text \"\${text}\")
+    set(up \"../../../\")
+    if(y MATCHES \"/\")
+      set(up \"../../../../\")
+    endif()
+    string(REPLACE \"@CREASE_PLUGIN_DIRS@\" \"\${up}${CREASE_INSTALL_PLUGINDIR}\" text \"\${text}\")
     file(WRITE \"\${out}/share/\${y}\" \"\${text}\")
   endforeach()
   file(INSTALL \${out}/share/ DESTINATION \"\${CMAKE_INSTALL_PREFIX}/${CREASE_INSTALL_DATADIR}/config\" \${modes})

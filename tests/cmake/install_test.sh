@@ -39,6 +39,10 @@ grep -q "plugin_dirs: \[$prefix/lib/crease/plugins\]" "$stage/etc/crease/robot.y
   || fail "/etc/crease/robot.yaml does not name the installed plugin directory"
 grep -q "plugin_dirs: \[../../../lib/crease/plugins\]" "$root/share/crease/config/sim.yaml" \
   || fail "sim.yaml does not name the installed plugin directory"
+for y in control vision; do
+  grep -q "plugin_dirs: \[../../../../lib/crease/plugins\]" "$root/share/crease/config/split/$y.yaml" \
+    || fail "split/$y.yaml does not name the installed plugin directory"
+done
 grep -q "ExecStart=$prefix/bin/creased" "$stage/lib/systemd/system/creased.service" || fail "unit's ExecStart"
 if grep -rl -e "$src" -e "build/release" "$root/share/crease/config" "$stage/etc/crease"; then
   fail "an installed configuration refers to the source or build tree"
