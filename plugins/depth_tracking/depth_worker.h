@@ -1,18 +1,17 @@
 // Runs the DepthTracker on a worker thread (non-RT: it takes milliseconds) over the frame sets a
 // depth source publishes into its frame channel (`depth_images`), with the newest sheet model
-// state the RT side handed over, and hands the targets back without locks or allocation, as the
-// vision worker does with key-points: woken by each publish, the newest set processed in place
-// (no copy of the images), the result written to a latest channel; the RT side copies it out.
+// state the RT side handed over, and hands the targets back without locks or allocation: a
+// FrameSetWorker (core/frames/frame_set_worker.h), as the vision worker does with key-points.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "core/frames/frame_channel.h"
+#include "core/frames/frame_set_worker.h"
 #include "core/port_types/depth_targets.h"
 #include "core/port_types/sheet_state.h"
 #include "plugins/depth_tracking/depth_tracker.h"
@@ -35,32 +34,21 @@ class DepthWorker {
   void set_model_rt(const crease::SheetState& model, std::int64_t now_ns) noexcept {
     model_.write(&model, now_ns);
   }
-  enum class Take { none, fresh, failed };
+  using Take = crease::frames::FrameSetWorker::Take;
   // RT-safe. Copies the newest result into `out` when there is one not yet taken.
-  Take take_rt(crease::DepthTargets& out) noexcept;
-  [[nodiscard]] std::uint64_t sets_processed() const noexcept {
-    return processed_.load(std::memory_order_acquire);
-  }
-  [[nodiscard]] std::string error() const;  // non-RT, valid after `failed`
+  Take take_rt(crease::DepthTargets& out) noexcept { return worker_.take_rt(&out); }
+  [[nodiscard]] std::uint64_t sets_processed() const noexcept { return worker_.sets_processed(); }
+  [[nodiscard]] std::string error() const { return worker_.error(); }  // non-RT, valid after `failed`
 
  private:
-  void run();
-  bool claim_reader();
+  void process(const crease::frames::FrameSet& set);  // worker thread
 
-  std::shared_ptr<crease::frames::FrameChannel> channel_;
   DepthTracker tracker_;
   std::unique_ptr<crease::SheetState> model_buf_;  // worker thread
   std::unique_ptr<crease::DepthTargets> result_;   // worker thread
   std::vector<cv::Mat> depth_, bgr_;               // worker thread: headers over the set
   crease::rt::LatestChannel model_{sizeof(crease::SheetState)};
-  crease::rt::LatestChannel results_{sizeof(crease::DepthTargets)};
-  std::uint64_t taken_ = 0;  // RT side
-  std::string error_;
-  bool reader_ = false;
-  std::atomic<bool> failed_{false};
-  std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> processed_{0};
-  std::thread thread_;
+  crease::frames::FrameSetWorker worker_;  // last: its thread stops before the members above go
 };
 
 }  // namespace crease::depth
