@@ -16,9 +16,9 @@
 #include "plugins/camera_rig/depth_camera.h"
 #include "plugins/camera_rig/marker_sheet.h"
 #include "plugins/cameras/camera_plugin.h"
+#include "plugins/cameras/sim_truth_feed.h"
 #include "plugins/sim_world/scene/depth_sim_source.h"
 #include "rt/clock.h"
-#include "rt/latest.h"
 
 namespace {
 
@@ -47,11 +47,7 @@ class CameraDepthSimPlugin final : public CameraPlugin {
     } else {
       p.fail("sheet", "must be plain or markers, not '" + sheet + "'");
     }
-    RenderOptions ro;
-    ro.seed = static_cast<std::uint64_t>(p.get_in_range<int>("seed", 1, 0, 1 << 30));
-    ro.noise_sigma = p.get_in_range<double>("noise", 2.0, 0.0, 50.0);
-    ro.blur_sigma_px = p.get_in_range<double>("blur_px", 0.6, 0.0, 5.0);
-    ro.occluders = p.get_in_range<int>("occluders", 0, 0, 10);
+    const RenderOptions ro = read_render_options(p);
     DepthSensorModel sm;
     sm.noise = p.get<bool>("depth_noise", true);
     sm.baseline_mm = p.get_in_range<double>("baseline_mm", sm.baseline_mm, 1.0, 1000.0);
@@ -63,14 +59,8 @@ class CameraDepthSimPlugin final : public CameraPlugin {
     sm.table_z_mm = p.get_in_range<double>("table_z_mm", sm.table_z_mm, -1e4, 1e4);
     sm.hand_height_mm = p.get_in_range<double>("hand_height_mm", sm.hand_height_mm, 0.0, 1e3);
     const double period_s = p.get_in_range<double>("frame_period_s", 1.0 / 30, 1e-3, 10.0);
-    truth_in_ = ports.latest_input<crease::SheetState>("sheet_truth");
-    truth_ch_ = std::make_shared<crease::rt::LatestChannel>(sizeof(crease::SheetState));
-    auto mesh_at = [ch = truth_ch_, buf = std::make_shared<crease::SheetState>()](std::uint64_t) {
-      // Worker thread: the newest truth the RT side handed over (no sheet until there is one).
-      if (!ch->read(buf.get(), 0).has_data()) return SheetMesh{};
-      return mesh_of(*buf);
-    };
-    auto src = std::make_unique<DepthSimSource>(std::move(cams), front, back, ppm, mesh_at, ro, sm, colour,
+    truth_.bind(ports);
+    auto src = std::make_unique<DepthSimSource>(std::move(cams), front, back, ppm, truth_.mesh_source(), ro, sm, colour,
                                                 static_cast<std::int64_t>(period_s * 1e9),
                                                 crease::rt::now_ns());
     configure_camera(p, ports, std::move(src), true, kDepthImagesPort, kDepthFramesPort);
@@ -78,13 +68,12 @@ class CameraDepthSimPlugin final : public CameraPlugin {
 
   crease::Status update(const crease::Cycle& cycle) override {
     // Hand the newest truth to the renderer before asking for the next frame.
-    if (truth_in_.poll().is_new()) truth_ch_->write(&truth_in_.value(), cycle.time_ns);
+    truth_.forward_rt(cycle.time_ns);
     return CameraPlugin::update(cycle);
   }
 
  private:
-  crease::LatestInput<crease::SheetState> truth_in_;
-  std::shared_ptr<crease::rt::LatestChannel> truth_ch_;
+  SimTruthFeed truth_;
 };
 
 }  // namespace
