@@ -1,0 +1,161 @@
+// Can the simulated robot reach the sheet where config/sim.yaml lays it? The folding sequence's
+// first goals (config/folds/half.yaml and diagonal.yaml: the right hand's approach and contact,
+// the left hand's grasp) in arm_motion's sheet frame of the world's sheet at its nominal pose
+// and at the randomisation's extremes (sim_world: +-30 mm, +-15 deg), solved with the arm's IK
+// (robot_model's ArmIk, the URDF's joint limits) from the rest posture and its restarts, as
+// given and turned about the sheet's normal (72 turns, 5 deg apart). Prints, per goal, the
+// shoulder's distance to the tool and to the wrist, and the IK's residual.
+// Failing variant: the arms mounted as before (1.3 m over the table, 450 mm behind the sheet's
+// centre): the approach is out of reach at every turn.
+#include <doctest/doctest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "plugins/fold_sequence/fold_spec.h"
+#include "plugins/robot_model/arm_ik.h"
+#include "plugins/robot_model/robot_model.h"
+
+using namespace crease;
+using robot::ArmIk;
+using robot::Side;
+using robot::ToolFrame;
+
+namespace {
+
+const std::string kConfig = std::string(CREASE_SOURCE_DIR) + "/config/";
+
+// The world's table height (sim.yaml's world params; sim_world's default 0).
+double table_height_mm() {
+  const YAML::Node root = YAML::LoadFile(kConfig + "sim.yaml");
+  for (const auto& p : root["plugins"])
+    if (p["library"].as<std::string>() == "sim_world" && p["params"]["table_height_mm"])
+      return p["params"]["table_height_mm"].as<double>();
+  return 0.0;
+}
+
+// arm_motion's sheet frame of a sheet lying flat: origin node (0, 0) at CORNER (world mm), x along
+// u, z = u x v into the table; the A4 sheet's u along +x and v along -y turned by YAW about z.
+KDL::Frame sheet_frame(double x_mm, double y_mm, double z_mm, double yaw_rad) {
+  return KDL::Frame(KDL::Rotation::RotZ(yaw_rad) * KDL::Rotation::RotX(std::numbers::pi),
+                    KDL::Vector(x_mm, y_mm, z_mm) / 1000.0);
+}
+
+struct Reach {
+  bool reached = false;     // some turn converged within the limits
+  double best_mm = 1e9;     // the smallest residual over the turns
+  int turns_reached = 0;    // of 72
+  double shoulder_tool_mm = 0;
+};
+
+// The shoulder (S2's axis) in the world: 0.417 m down the arm's base from its mount.
+KDL::Vector shoulder(const robot::RobotModel& m, Side s) { return m.mount(s) * KDL::Vector(0, 0, 0.417); }
+
+Reach reach(const robot::RobotModel& m, Side side, ToolFrame tool, const KDL::Frame& goal) {
+  ArmIk ik(m, side);
+  const ArmIk::Joints rest = ik.options().rest_rad;
+  const std::array<double, robot::kHandJoints> hand{};  // the sequence's open hand
+  REQUIRE(ik.set_tool(tool, rest, hand));
+  Reach r;
+  r.shoulder_tool_mm = 1000.0 * (goal.p - shoulder(m, side)).Norm();
+  for (int k = 0; k < 72; ++k) {
+    const KDL::Frame g(goal.M * KDL::Rotation::RotZ(k * std::numbers::pi / 36.0), goal.p);
+    ArmIk::Joints q{};
+    const ArmIk::Result res = ik.solve(g, rest, q);
+    r.best_mm = std::min(r.best_mm, 1000.0 * res.error_m);
+    if (res.converged) {
+      r.reached = true;
+      ++r.turns_reached;
+    }
+  }
+  return r;
+}
+
+KDL::Frame sheet_goal(const KDL::Frame& sheet, const double p_mm[3], const double q[4]) {
+  return sheet * KDL::Frame(KDL::Rotation::Quaternion(q[0], q[1], q[2], q[3]),
+                            KDL::Vector(p_mm[0], p_mm[1], p_mm[2]) / 1000.0);
+}
+
+// Every first goal of FOLD at every extreme of the sheet's pose; prints the figures.
+int unreachable_goals(const robot::RobotModel& m, const std::string& fold, const std::string& tag) {
+  const fold::FoldSpec f = fold::load_fold_file(kConfig + "folds/" + fold + ".yaml");
+  const double z = table_height_mm();
+  int missed = 0;
+  for (double dx : {0.0, -30.0, 30.0})
+    for (double dy : {0.0, -30.0, 30.0})
+      for (double yaw_deg : {0.0, -15.0, 15.0}) {
+        // The sheet turns about its centre (sim_world's randomise): the corner moves with it.
+        const double yaw = yaw_deg * std::numbers::pi / 180.0;
+        const KDL::Vector c(dx, dy, 0), corner0(-105, 148.5, 0);
+        const KDL::Vector corner = c + KDL::Rotation::RotZ(yaw) * corner0;
+        const KDL::Frame sheet = sheet_frame(corner.x(), corner.y(), z, yaw);
+        const double approach[3] = {f.shift.at_mm[0], f.shift.at_mm[1], -f.shift.approach_height_mm};
+        const double contact[3] = {f.shift.at_mm[0], f.shift.at_mm[1], 0.0};
+        struct Goal {
+          const char* what;
+          Side side;
+          std::uint8_t tool;
+          const double* p;
+          const double* q;
+        } goals[] = {
+            {"shift approach", Side::right, f.shift.tool, approach, f.shift.orientation},
+            {"shift contact", Side::right, f.shift.tool, contact, f.shift.orientation},
+            {"grasp above", Side::left, f.grasp_tool, f.grasp_above_mm, f.grasp_orientation},
+            {"grasp at", Side::left, f.grasp_tool, f.grasp_at_mm, f.grasp_orientation},
+        };
+        for (const Goal& g : goals) {
+          const KDL::Frame goal = sheet_goal(sheet, g.p, g.q);
+          const Reach r = reach(m, g.side, static_cast<ToolFrame>(g.tool), goal);
+          if (!r.reached) ++missed;
+          if (dx == 0 && dy == 0 && yaw_deg == 0)
+            MESSAGE(tag << " " << fold << " " << std::string(g.what) << ": tool at (" << 1000 * goal.p.x() << ", "
+                        << 1000 * goal.p.y() << ", " << 1000 * goal.p.z() << ") mm, " << r.shoulder_tool_mm
+                        << " mm from the shoulder; " << r.turns_reached << " of 72 turns reached, best residual "
+                        << r.best_mm << " mm");
+        }
+      }
+  return missed;
+}
+
+// The shipped robot file with its mounts edited (the URDF beside it, copied).
+robot::RobotModel mounted(double z_mm, double y_mm) {
+  std::ifstream in(kConfig + "robot/crease_robot.yaml");
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  for (const char* x : {"[300, ", "[-300, "}) {
+    const std::string from = std::string("mount: {xyz_mm: ") + x;
+    const auto at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    const auto end = text.find(']', at);
+    text.replace(at, end - at + 1,
+                 from + std::to_string(static_cast<int>(y_mm)) + ", " + std::to_string(static_cast<int>(z_mm)) + "]");
+  }
+  const auto dir = std::filesystem::temp_directory_path() / ("crease_sim_reach_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kConfig + "robot/crease_robot.urdf", dir / "crease_robot.urdf",
+                             std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(dir / "crease_robot.yaml") << text;
+  return robot::RobotModel::load((dir / "crease_robot.yaml").string());
+}
+
+}  // namespace
+
+TEST_CASE("the arms reach the sequence's first goals on the sheet where sim.yaml lays it, at every pose the world draws") {
+  const robot::RobotModel shipped = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
+  MESSAGE("right mount at (" << 1000 * shipped.mount(Side::right).p.x() << ", " << 1000 * shipped.mount(Side::right).p.y()
+                             << ", " << 1000 * shipped.mount(Side::right).p.z() << ") mm, table at " << table_height_mm()
+                             << " mm");
+  CHECK(unreachable_goals(shipped, "half", "shipped") == 0);
+  CHECK(unreachable_goals(shipped, "diagonal", "shipped") == 0);
+
+  // Failing variant: the mounts as they were.
+  const robot::RobotModel before = mounted(1300, -450);
+  CHECK(unreachable_goals(before, "half", "1.3 m mounts") > 0);
+}
