@@ -31,8 +31,10 @@ struct WorldPluginConfig {
 [[nodiscard]] WorldPluginConfig read_world_config(const Params& p);
 
 // The parked pose of each arm (deg, drivers/README.md §4 order) when the parameters give none:
-// each palm 300 mm over the table, facing down, beside the sheet (x = +-230, y = -230 mm).
-inline constexpr double kParkedArmDeg[2][7] = {{-42.8, -34.1, 15.3, 123.9, -171.5, 90.8, 30.2},
-                                               {-5.0, -36.7, 13.0, 125.4, 7.7, -89.4, -5.6}};
+// each index pad 300 mm over the table, facing down, beside the sheet (x = +-230, y = -230 mm),
+// every joint at least 20 deg inside its limits (the IK's solution with the most margin over 72
+// turns about the vertical; tests/config/sim_reach_test.cpp checks the pose).
+inline constexpr double kParkedArmDeg[2][7] = {{79.8, -43.4, 64.1, 106.7, -58.0, 144.4, -97.7},
+                                               {97.1, 45.8, -64.4, -106.0, -122.4, 143.2, 100.2}};
 
 }  // namespace crease::world

@@ -21,6 +21,7 @@
 #include "plugins/fold_sequence/fold_spec.h"
 #include "plugins/robot_model/arm_ik.h"
 #include "plugins/robot_model/robot_model.h"
+#include "plugins/sim_world/world_config.h"
 
 using namespace crease;
 using robot::ArmIk;
@@ -54,8 +55,8 @@ struct Reach {
   double shoulder_tool_mm = 0;
 };
 
-// The shoulder (S2's axis) in the world: 0.417 m down the arm's base from its mount.
-KDL::Vector shoulder(const robot::RobotModel& m, Side s) { return m.mount(s) * KDL::Vector(0, 0, 0.417); }
+// The shoulder (S2's axis) in the world: 0.317 m down the arm's base from its mount.
+KDL::Vector shoulder(const robot::RobotModel& m, Side s) { return m.mount(s) * KDL::Vector(0, 0, 0.317); }
 
 Reach reach(const robot::RobotModel& m, Side side, ToolFrame tool, const KDL::Frame& goal) {
   ArmIk ik(m, side);
@@ -158,4 +159,25 @@ TEST_CASE("the arms reach the sequence's first goals on the sheet where sim.yaml
   // Failing variant: the mounts as they were.
   const robot::RobotModel before = mounted(1300, -450);
   CHECK(unreachable_goals(before, "half", "1.3 m mounts") > 0);
+}
+
+TEST_CASE("the arms' parked pose (sim_world's default): each index pad 300 mm over the table, facing down, beside the sheet, clear of the limits") {
+  robot::RobotModel m = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
+  const std::array<double, robot::kHandJoints> hand{};
+  for (Side s : {Side::right, Side::left}) {
+    const int i = s == Side::right ? 0 : 1;
+    ArmIk::Joints q{};
+    for (int j = 0; j < robot::kArmJoints; ++j) q[j] = world::kParkedArmDeg[i][j] * std::numbers::pi / 180.0;
+    KDL::Frame pad;
+    REQUIRE(m.tool_pose_m(s, ToolFrame::ff_pad, q, hand, pad));
+    CHECK(std::fabs(1000 * pad.p.x() - (i == 0 ? 230 : -230)) < 1.0);
+    CHECK(std::fabs(1000 * pad.p.y() + 230) < 1.0);
+    CHECK(std::fabs(1000 * pad.p.z() - (table_height_mm() + 300)) < 1.0);
+    CHECK(pad.M.UnitZ().z() < -0.999);  // the pad's outward normal down
+    const ArmIk ik(m, s);
+    for (int j = 0; j < robot::kArmJoints; ++j) {
+      CHECK(q[j] > ik.lower()[j] + 0.3);  // 17 deg
+      CHECK(q[j] < ik.upper()[j] - 0.3);
+    }
+  }
 }

@@ -105,14 +105,14 @@ TEST_CASE("forward kinematics: the flange and the tool frames equal KDL's own so
   // By hand: S1 = 90 deg turns the arm about the base's z, E1 = 90 deg bends the forearm (E1 ->
   // flange 0.48 + 0.07 m) about the then base y axis. In the base frame (z down from the
   // ceiling mount) Rx(90) takes (0, 0, L) to (0, -L, 0), Rz(90) then to (L, 0, 0): the flange
-  // at base (0.55, 0, 0.767), world (0.3 + x, -0.45 - y, 1.3 - z) = (0.85, -0.45, 0.533).
+  // at base (0.55, 0, 0.767), world (0.3 + x, -0.3 - y, 1.0 - z) = (0.85, -0.3, 0.233).
   Joints q{};
   q[0] = 90 * kDeg;
   q[3] = 90 * kDeg;
   const Hand hand{};
   REQUIRE(ik.set_tool(ToolFrame::flange, q, hand));
   const KDL::Frame f = ik.tool_pose(q);
-  CHECK(exact_norm((f.p - KDL::Vector(0.85, -0.45, 1.3 - 0.767))) < 1e-9);
+  CHECK(exact_norm((f.p - KDL::Vector(0.85, -0.3, 1.0 - 0.767))) < 1e-9);
   const KDL::Rotation r = KDL::Rotation::RotX(kPi) * KDL::Rotation::RotZ(90 * kDeg) * KDL::Rotation::RotX(90 * kDeg);
   CHECK(rot_angle(f.M, r) < 1e-9);
 }
@@ -214,14 +214,14 @@ TEST_CASE("unreachable targets are reported as such") {
   const Hand hand{};
   REQUIRE(ik.set_tool(ToolFrame::ff_pad, ik.options().rest_rad, hand));
   Joints q{};
-  // 3 m from the shoulder: beyond the arm's 1.3 m reach.
+  // 2.8 m from the shoulder: beyond the arm's 1.3 m reach.
   ArmIk::Result r = ik.solve(KDL::Frame(KDL::Vector(0.3, 2.5, 0.2)), ik.options().rest_rad, q);
   CHECK_FALSE(r.converged);
   CHECK(r.error_m > 0.5);
   CHECK(r.attempts == ik.options().restarts + 1);
   CHECK(within_limits(ik, q));
   // Under the arm's own base, pointing the pad up into the mount: within reach of nothing.
-  r = ik.solve(KDL::Frame(KDL::Rotation::RotY(kPi / 2), KDL::Vector(0.3, -0.45, 1.45)), ik.options().rest_rad, q);
+  r = ik.solve(KDL::Frame(KDL::Rotation::RotY(kPi / 2), KDL::Vector(0.3, -0.3, 1.15)), ik.options().rest_rad, q);
   CHECK_FALSE(r.converged);
   CHECK(within_limits(ik, q));
 }

@@ -47,9 +47,9 @@ void check_frame(const KDL::Frame& got, const KDL::Vector& p, const KDL::Rotatio
 }
 
 // Hand computation of the shipped URDF's numbers (see its header comment): the right arm's
-// base hangs at (0.3, -0.45, 1.3) m, rotated 180 deg about x, so base (x, y, z) is world
-// (0.3 + x, -0.45 - y, 1.3 - z). In the base frame at zero the arm and hand stretch along +z.
-KDL::Vector right_base_to_world(double x, double y, double z) { return {0.3 + x, -0.45 - y, 1.3 - z}; }
+// base hangs at (0.3, -0.3, 1.0) m, rotated 180 deg about x, so base (x, y, z) is world
+// (0.3 + x, -0.3 - y, 1.0 - z). In the base frame at zero the arm and hand stretch along +z.
+KDL::Vector right_base_to_world(double x, double y, double z) { return {0.3 + x, -0.3 - y, 1.0 - z}; }
 // A rotation about axes of the right arm's base frame, as a rotation of world vectors.
 KDL::Rotation in_world(const KDL::Rotation& in_base) {
   return KDL::Rotation::RotX(kPi) * in_base * KDL::Rotation::RotX(kPi).Inverse();
@@ -257,7 +257,7 @@ TEST_CASE("the left hand mirrors the right in x at zero; pads face the palm's si
 TEST_CASE("the YAML's mounting replaces the URDF's: a 10 mm shift moves every tool frame by 10 mm") {
   const std::string yaml = robot_files::read(robot_files::shipped("crease_robot.yaml"));
   const std::string urdf = robot_files::read(robot_files::shipped("crease_robot.urdf"));
-  const std::string moved = robot_files::replace(yaml, "xyz_mm: [300, -450, 1300]", "xyz_mm: [310, -450, 1250]");
+  const std::string moved = robot_files::replace(yaml, "xyz_mm: [300, -300, 1000]", "xyz_mm: [310, -300, 950]");
   RobotModel a = shipped_model();
   RobotModel b = RobotModel::load(robot_files::write_robot(moved, "mount_shift.urdf", urdf));
   const auto arm = zero_arm();
@@ -272,7 +272,7 @@ TEST_CASE("the YAML's mounting replaces the URDF's: a 10 mm shift moves every to
     REQUIRE(b.tool_pose_m(Side::left, static_cast<ToolFrame>(f), arm, hand, pb));
     check_frame(pb, pa.p, pa.M, 1e-12);
   }
-  CHECK(b.mount(Side::right).p.z() == doctest::Approx(1.25));
+  CHECK(b.mount(Side::right).p.z() == doctest::Approx(0.95));
 }
 
 TEST_CASE("collision shapes: pads are their own links, fingertips are covered, friction per side") {

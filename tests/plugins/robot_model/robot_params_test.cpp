@@ -44,8 +44,8 @@ TEST_CASE("the shipped parameters: mounting, materials, friction and sensors per
   const SideParams& l = p.side(Side::left);
   CHECK(r.prefix == "r_");
   CHECK(l.prefix == "l_");
-  CHECK(r.mount.xyz_mm == std::array<double, 3>{300, -450, 1300});
-  CHECK(l.mount.xyz_mm == std::array<double, 3>{-300, -450, 1300});
+  CHECK(r.mount.xyz_mm == std::array<double, 3>{300, -300, 1000});
+  CHECK(l.mount.xyz_mm == std::array<double, 3>{-300, -300, 1000});
   CHECK(r.mount.rpy_deg == std::array<double, 3>{180, 0, 0});
   CHECK(r.cover == "rubber");
   CHECK(l.cover == "fabric");
@@ -95,7 +95,7 @@ TEST_CASE("errors name the file, line, column and key") {
               .find("sides.right.tactile.contact_sigma_mm: must be in (0, 20], got -1") != std::string::npos);
   }
   SUBCASE("a missing mounting") {
-    CHECK(error_of("mm.yaml", "    mount: {xyz_mm: [-300, -450, 1300], rpy_deg: [180, 0, 0]}\n", "")
+    CHECK(error_of("mm.yaml", "    mount: {xyz_mm: [-300, -300, 1000], rpy_deg: [180, 0, 0]}\n", "")
               .find("sides.left.mount: required key is missing") != std::string::npos);
   }
   SUBCASE("an unknown tactile kind") {

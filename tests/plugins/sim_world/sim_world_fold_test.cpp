@@ -8,11 +8,12 @@
 // lies over the near one (mean distance in x, y over the 29 columns) and the far half lies on
 // top of the near half.
 //
-// The scene: the table raised 300 mm and the sheet 150 mm nearer the robot (its far edge 53.5 mm
-// over the table's far edge). With the table 1.3 m under the mounts (config/robot) the PA-10's
-// elbow stretches straight before the pinch has turned 60 deg; carried away from the robot
-// (the near edge over to the far one) the turning hand's wrist moves away from the shoulder and
-// the elbow straightens too, at any table height tried (0-400 mm).
+// The scene: the shipped robot (config/robot: the arms 1 m over the table, 300 mm behind the
+// sheet's centre) and the sheet where the world lays it, the table's far edge 53.5 mm inside the
+// sheet's far edge. (With the arms 1.3 m over the table and 450 mm behind, the mounts before,
+// the PA-10's elbow stretched straight before the pinch had turned 60 deg; carried away from the
+// robot (the near edge over to the far one) the turning hand's wrist moves away from the
+// shoulder and the elbow straightens too.)
 // Failing variants: frictionless fingers: the pinch loses the edge at ~60 deg and it falls back;
 // the left index not pressing: the pinch drags the near half after it.
 #include <algorithm>
@@ -27,8 +28,8 @@ using namespace scene;
 
 namespace {
 
-constexpr double kTableMm = 300.0;   // the table's top (z)
-constexpr double kSheetDyMm = -150;  // the sheet's centre (y): its far edge at y = -1.5
+constexpr double kTableMm = 0.0;    // the table's top (z): sim_world's
+constexpr double kSheetDyMm = 0.0;   // the sheet's centre (y): its far edge at y = 148.5
 constexpr double kCloseThj5 = 0.77;  // the pinch squeezes (reference_poses.h: 0.696 touches)
 
 // One arm and hand driven by a tool pose: arm IK every step (scene.h), hand targets, stiffness.
@@ -140,8 +141,8 @@ double near_edge_y(const World& w) {
 
 // FIXATE false: the left index hovers 8 mm over the near half instead of pressing it.
 Fold fold(WorldParams p, Bimanual& b, bool fixate = true) {
-  p.sheet.grid.origin_mm.y += kSheetDyMm;
-  p.table_height_mm = kTableMm;
+  REQUIRE(p.table_height_mm == kTableMm);
+  REQUIRE(p.sheet.grid.origin_mm.y == 148.5 + kSheetDyMm);
   p.table_extent_mm = {-WorldParams::kNoEdge, WorldParams::kNoEdge, -WorldParams::kNoEdge, 95.0 + kSheetDyMm};
   b.params = p;
   // The pinch (reference_poses.h) turned about z to reach the far edge from beyond it, the index
