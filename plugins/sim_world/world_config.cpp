@@ -33,6 +33,27 @@ std::array<double, N> read_angles_deg(const Params& p, const char* key, const do
   return out;
 }
 
+// The table top's extent: [x_min, x_max, y_min, y_max] mm, each a number or null (no edge on
+// that side); absent: a plane.
+void read_table_extent(const Params& p, std::array<double, 4>& out) {
+  const char* key = "table_extent_mm";
+  if (!p.has(key)) return;
+  const YAML::Node n = p.raw(key);
+  if (!n.IsSequence() || n.size() != 4) p.fail(key, "expected [x_min, x_max, y_min, y_max] mm (null: no edge)");
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (n[i].IsNull()) continue;  // the default: no edge
+    double v = 0;
+    try {
+      v = n[i].as<double>();
+    } catch (const YAML::Exception&) {
+      p.fail(key, "element " + std::to_string(i) + " is not a number or null");
+    }
+    if (!std::isfinite(v) || std::fabs(v) > 5000.0) p.fail(key, "element " + std::to_string(i) + " must be in [-5000, 5000] mm");
+    out[i] = v;
+  }
+  if (!(out[0] < out[1]) || !(out[2] < out[3])) p.fail(key, "each minimum must be below its maximum");
+}
+
 }  // namespace
 
 WorldPluginConfig read_world_config(const Params& p) {
@@ -52,6 +73,7 @@ WorldPluginConfig read_world_config(const Params& p) {
   g.origin_mm.x = p.get_in_range<double>("origin_x_mm", g.origin_mm.x, -1000.0, 1000.0);
   g.origin_mm.y = p.get_in_range<double>("origin_y_mm", g.origin_mm.y, -1000.0, 1000.0);
   w.table_height_mm = p.get_in_range<double>("table_height_mm", w.table_height_mm, -500.0, 500.0);
+  read_table_extent(p, w.table_extent_mm);
   w.initial_stiffness_nm_per_rad =
       p.get_in_range<double>("initial_stiffness_nm_per_rad", w.initial_stiffness_nm_per_rad, 0.0, 1000.0);
   const double zero_hand[robot::kHandJoints] = {};

@@ -32,9 +32,11 @@ struct WorldPluginConfig {
 
 // The parked pose of each arm (deg, drivers/README.md §4 order) when the parameters give none:
 // each index pad 300 mm over the table, facing down, beside the sheet (x = +-230, y = -230 mm),
-// every joint at least 20 deg inside its limits (the IK's solution with the most margin over 72
-// turns about the vertical; tests/config/sim_reach_test.cpp checks the pose).
-inline constexpr double kParkedArmDeg[2][7] = {{79.8, -43.4, 64.1, 106.7, -58.0, 144.4, -97.7},
-                                               {97.1, 45.8, -64.4, -106.0, -122.4, 143.2, 100.2}};
+// turned about the vertical as the half fold's first goal of that arm (config/folds/half.yaml:
+// the right's tool x along world +y, the left's 60 deg from +x), every joint at least 25 deg
+// inside its limits (the IK's solution with the most margin; tests/config/sim_reach_test.cpp
+// checks the pose).
+inline constexpr double kParkedArmDeg[2][7] = {{73.3, -60.1, 59.0, 106.0, -54.2, 130.5, -112.6},
+                                               {-47.0, -51.1, -59.3, 109.1, 56.1, 131.8, 103.2}};
 
 }  // namespace crease::world

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,7 @@
 #include "core/port_types/hand_goal.h"
 #include "core/port_types/tactile.h"
 #include "plugins/sim_world/scene.h"
+#include "plugins/sim_world/world_config.h"
 #include "plugins/sim_world/tactile_model.h"
 #include "rt/alloc_guard.h"
 #include "rt/latest.h"
@@ -76,17 +78,16 @@ class HandWorld {
  public:
   explicit HandWorld(Options o)
       : o_(std::move(o)), me_(static_cast<int>(o_.side)), ik_(robot_model(), o_.side),
-        ik_other_(robot_model(), other(o_.side)),
         pst_(robot_model().params().side(robot::Side::left).tactile, o_.sensor_seed),
         taxels_(robot_model().params().side(robot::Side::right).tactile, o_.sensor_seed + 17),
         noise_(robot_model().params().side(robot::Side::left).tactile, o_.sensor_seed + 31),
         host_({CREASE_PLUGIN_DIR}) {
     hand_q_ = index_out();
     palm_ = palm_forward_down(o_.side, deg(30));
-    const double sx = o_.side == robot::Side::right ? -1.0 : 1.0;
     q_ = ik_.solve("ffpad", o_.start, palm_, hand_q_, arm_guess());
-    q_other_ = ik_other_.solve("palm", {400 * sx, -150, 300}, frame_from_z_x({0, 0, -1}, {-sx, 0, 0}), HandQ{},
-                               arm_guess());
+    // The other arm parked as creased parks it (sim_world's default: its pad 300 mm over the
+    // table beside the sheet).
+    for (int j = 0; j < robot::kArmJoints; ++j) q_other_[j] = world::kParkedArmDeg[1 - me_][j] * std::numbers::pi / 180.0;
     WorldParams& p = o_.world;
     p.initial_stiffness_nm_per_rad = o_.stiffness;
     p.initial_arm_rad[me_] = q_;
@@ -358,7 +359,7 @@ class HandWorld {
 
   Options o_;
   int me_;
-  ArmIk ik_, ik_other_;
+  ArmIk ik_;
   crease::world::TactileModel pst_, taxels_, noise_;
   crease::PluginHost host_;
   crease::Loop* loop_ = nullptr;

@@ -63,12 +63,22 @@ class ArmIk {
   }
 
   // Arm angles putting link TOOL's origin (without prefix) at p_mm with the palm turned to
-  // PALM, the hand at HAND, starting from GUESS. Fails the test when the solver does not reach
-  // it within TOL_MM (0.01 mm) or leaves a joint's limits.
+  // PALM, the hand at HAND, starting from GUESS (then, if that ends outside the limits or short
+  // of the pose, from a fixed grid of guesses over the shoulder, elbow and wrist: the first
+  // within both). Fails the test when none reaches it within TOL_MM (0.01 mm) within the limits.
   ArmQ solve(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess,
              double tol_mm = 0.01) {
-    const Attempt a = attempt(tool, p_mm, palm, hand, guess);
-    if (!(a.err_mm < tol_mm)) std::printf("ik: rc %d err %.4f mm\n", a.rc, a.err_mm);
+    Attempt a = attempt(tool, p_mm, palm, hand, guess);
+    for (double s1 : {0.0, 0.5, -0.5, 1.0, -1.0})
+      for (double s2 : {0.5, 0.2, 0.8, -0.3, 1.2})
+        for (double e1 : {1.4, 0.8, 2.0, 2.3})
+          for (double w1 : {1.2, 0.6, -0.6, 1.6}) {
+            if (a.within_limits && a.err_mm < tol_mm) break;
+            a = attempt(tool, p_mm, palm, hand, {s1, s2, 0.0, e1, 0.0, w1, 0.0});
+          }
+    if (!(a.err_mm < tol_mm && a.within_limits))
+      std::printf("ik: %s at (%.1f, %.1f, %.1f) mm: rc %d err %.4f mm, within limits %d\n", tool.c_str(), p_mm.x, p_mm.y,
+                  p_mm.z, a.rc, a.err_mm, static_cast<int>(a.within_limits));
     REQUIRE(a.err_mm < tol_mm);
     for (int i = 0; i < robot::kArmJoints; ++i) {
       REQUIRE(a.q[i] >= lo_[i]);

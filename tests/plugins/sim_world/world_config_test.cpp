@@ -1,0 +1,54 @@
+// sim_world's table parameters: the table's extent (an edge to overhang) read as given, null
+// sides without an edge, and every malformed extent a ConfigError naming file, line and key.
+#include "plugins/sim_world/world_config.h"
+
+#include <doctest/doctest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+
+#include "core/errors.h"
+
+using namespace crease;
+using crease::world::read_world_config;
+using crease::world::WorldParams;
+
+namespace {
+
+world::WorldPluginConfig read(const std::string& extra) {
+  const std::string yaml = "robot: " CREASE_SOURCE_DIR "/config/robot/crease_robot.yaml\n" + extra;
+  return read_world_config(Params(YAML::Load(yaml), "sim.yaml", "world.params"));
+}
+
+std::string error_of(const std::string& extra) {
+  try {
+    (void)read(extra);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("table_extent_mm: absent a plane, given the slab's sides, null a side without an edge") {
+  const auto plane = read("").world.table_extent_mm;
+  for (double v : {plane[0], plane[2]}) CHECK(v == -WorldParams::kNoEdge);
+  for (double v : {plane[1], plane[3]}) CHECK(v == WorldParams::kNoEdge);
+
+  const auto e = read("table_extent_mm: [-400, 400, -175, null]\n").world.table_extent_mm;
+  CHECK(e[0] == -400.0);
+  CHECK(e[1] == 400.0);
+  CHECK(e[2] == -175.0);
+  CHECK(e[3] == WorldParams::kNoEdge);
+}
+
+TEST_CASE("table_extent_mm: a malformed extent names file, line and key") {
+  for (const char* bad : {"table_extent_mm: [1, 2, 3]\n", "table_extent_mm: 5\n", "table_extent_mm: [0, x, 0, 1]\n",
+                          "table_extent_mm: [0, 1e9, 0, 1]\n", "table_extent_mm: [10, 0, 0, 1]\n"}) {
+    const std::string e = error_of(bad);
+    INFO(bad << " -> " << e);
+    CHECK(e.find("sim.yaml:2") != std::string::npos);
+    CHECK(e.find("table_extent_mm") != std::string::npos);
+  }
+}
