@@ -71,11 +71,12 @@ ArmMotionConfig parse_arm_motion_params(const Params& p) {
   m.check_step_rad = p.get_in_range<double>("check_step_rad", m.check_step_rad, 0.001, 1.0);
   m.joint_speed_fraction = p.get_in_range<double>("joint_speed_fraction", m.joint_speed_fraction, 0.01, 1.0);
   m.ik.track_iterations = p.get_in_range<int>("track_iterations", m.ik.track_iterations, 1, 50);
-  // The palm flat 150 mm above the table, 117 mm to the side's side of the centre, fingers
-  // forward (+y): where the hands work; found with ArmIk from the elbow-bent seed.
+  // The palm flat 150 mm above the table, 150 mm to the side's side of the centre and 50 mm
+  // nearer the robot, fingers forward (+y): where the hands work; found with ArmIk for the arms
+  // of config/robot (1 m over the table), every joint at least 28 deg inside its limits.
   m.ik.rest_rad = c.side == robot::Side::right
-                      ? robot::ArmIk::Joints{-0.628, -0.341, -0.263, 0.958, 0.942, 1.243, 2.589}
-                      : robot::ArmIk::Joints{-0.908, -0.596, 0.306, 0.958, 0.708, 1.167, 3.030};
+                      ? robot::ArmIk::Joints{-0.535, -0.993, -0.427, 1.890, 0.819, 1.125, 2.230}
+                      : robot::ArmIk::Joints{0.535, -0.993, 0.426, 1.890, -0.819, 1.124, -2.230};
   if (p.has("rest_posture_deg")) {
     const YAML::Node n = p.raw("rest_posture_deg");
     if (!n.IsSequence() || n.size() != robot::kArmJoints) {

@@ -186,3 +186,4 @@ TEST_CASE("the arms' parked pose (sim_world's default): each index pad 300 mm ov
   }
 }
 
+

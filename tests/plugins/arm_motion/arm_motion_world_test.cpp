@@ -26,8 +26,8 @@ using crease::world::WorldParams;
 
 namespace {
 
-// The left arm parked with its palm 150 mm above the table on its side.
-Joints left_park() { return {-0.908, -0.596, 0.306, 0.958, 0.708, 1.167, 3.030}; }
+// The left arm parked with its palm 150 mm above the table on its side (arm_motion's left rest posture).
+Joints left_park() { return {0.535, -0.993, 0.426, 1.890, -0.819, 1.124, -2.230}; }
 
 struct WorldRig {
   WorldRig() {

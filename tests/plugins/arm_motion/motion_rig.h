@@ -35,7 +35,7 @@ inline robot::RobotModel& model() {
 }
 
 // The right palm flat 150 mm above the table, fingers forward (arm_motion's default rest posture).
-inline Joints start_posture() { return {-0.628, -0.341, -0.263, 0.958, 0.942, 1.243, 2.589}; }
+inline Joints start_posture() { return {-0.535, -0.993, -0.427, 1.890, 0.819, 1.125, 2.230}; }
 
 // The controller's defaults with the rest posture at the start posture.
 inline MotionParams params() {
