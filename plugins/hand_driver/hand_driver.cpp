@@ -77,6 +77,9 @@ class HandDriver final : public Plugin {
       }
       dr::TactileHostConfig tc;
       tc.rate_hz = static_cast<std::uint16_t>(p.get_in_range<int>("tactile_rate_hz", 250, 1, 1000));
+      // Older than this, the taxels are a link fault (the default: 5 samples at 250 Hz).
+      tc.max_age_ns = static_cast<std::int64_t>(
+          1e6 * p.get_in_range<double>("tactile_max_age_ms", static_cast<double>(tc.max_age_ns) / 1e6, 1.0, 1000.0));
       tactile_ = std::make_unique<dr::TactileReader>(std::make_unique<dr::FdSerialIo>(serial_->fd()), tc, "crease-tactile");
       tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
     }
