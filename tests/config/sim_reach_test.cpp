@@ -6,7 +6,9 @@
 // given (which must be reached) and turned about the sheet's normal (72 turns, 5 deg apart:
 // how many are). Prints, per goal, the shoulder's distance to the tool and the IK's residual.
 // Failing variant: the arms mounted as before (1.3 m over the table, 450 mm behind the sheet's
-// centre): the approach is out of reach at every turn.
+// centre): the approach is out of reach at every turn. And at the shift's contact, the open
+// hand's shells (plastic) clear of the sheet by more than the descent's depth over its lowest
+// fingertip cover; failing variant: the pad flat on the sheet.
 #include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -21,6 +23,7 @@
 #include "plugins/fold_sequence/fold_spec.h"
 #include "plugins/robot_model/arm_ik.h"
 #include "plugins/robot_model/robot_model.h"
+#include "plugins/sim_world/sim_world.h"
 #include "plugins/sim_world/world_config.h"
 
 using namespace crease;
@@ -187,3 +190,63 @@ TEST_CASE("the arms' parked pose (sim_world's default): each index pad 300 mm ov
 }
 
 
+
+// The open hand over the sheet at the shift's contact (the sequence's first touch): how far
+// above its lowest fingertip cover (rubber) its lowest shell (plastic: palm, wrist, forearm,
+// phalanges, thumb) is, in mm, with the tool at ORIENTATION (sheet frame, the fold file's
+// convention), on the nominal sheet. The hand's shapes where the world puts them
+// (sim_world's shapes at the arm's IK solution; the heights do not depend on the sheet's yaw).
+struct Clearance {
+  double shell_over_cover_mm = 0;
+  std::string lowest_shell;
+};
+Clearance contact_clearance(const robot::RobotModel& m, const fold::FoldSpec& f, const double orientation[4]) {
+  const KDL::Frame sheet = sheet_frame(-105, 148.5, table_height_mm(), 0);
+  const double contact[3] = {f.shift.at_mm[0], f.shift.at_mm[1], 0.0};
+  ArmIk ik(m, Side::right);
+  const std::array<double, robot::kHandJoints> open{};  // the sequence's open hand
+  REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.shift.tool), ik.options().rest_rad, open));
+  ArmIk::Joints q{};
+  REQUIRE(ik.solve(sheet_goal(sheet, contact, orientation), ik.options().rest_rad, q).converged);
+  world::WorldParams p;
+  p.table_height_mm = table_height_mm();
+  p.hand_contacts = false;  // where the arm puts the hand, nothing deflecting it
+  p.randomise = false;
+  for (int j = 0; j < robot::kArmJoints; ++j) p.initial_arm_rad[0][j] = q[j];
+  world::World w(m, p);
+  w.step_rt();
+  const double cover_k = world::WorldParams{}.contact_stiffness_n_per_mm3.at(m.params().side(Side::right).cover);
+  double cover = 1e9, shell = 1e9;
+  Clearance c;
+  for (const world::WorldShape& s : w.shapes()) {
+    if (s.side != static_cast<int>(Side::right)) continue;
+    const double z = world::lowest_point(s.geom, s.pose1).z;
+    if (s.stiffness_n_per_mm3 == cover_k) {
+      cover = std::min(cover, z);
+    } else if (s.role != world::ShapeRole::arm && z < shell) {
+      shell = z;
+      c.lowest_shell = w.kinematics(Side::right).link_name(s.link);
+    }
+  }
+  c.shell_over_cover_mm = shell - cover;
+  return c;
+}
+
+TEST_CASE("at the shift's contact the open hand touches the sheet with its fingertip covers only, its shells clear by more than the descent's depth") {
+  const robot::RobotModel m = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
+  for (const char* name : {"half", "diagonal"}) {
+    const fold::FoldSpec f = fold::load_fold_file(kConfig + "folds/" + name + ".yaml");
+    // As shipped: the pad pitched 20 deg (the fingers down, the wrist up).
+    const Clearance shipped = contact_clearance(m, f, f.shift.orientation);
+    MESSAGE(std::string(name) << ": the lowest shell (" << shipped.lowest_shell << ") " << shipped.shell_over_cover_mm
+                 << " mm over the lowest fingertip cover");
+    CHECK(shipped.shell_over_cover_mm > f.shift.contact_depth_mm);
+    // Failing variant: the pad flat on the sheet (the orientation before, turned about the
+    // normal only): the forearm's flange shell, the thumb, wrist and palm hang below the pads.
+    const double flat[4] = {0, 0, -0.70711, 0.70711};
+    const Clearance before = contact_clearance(m, f, flat);
+    MESSAGE(std::string(name) << ", the pad flat: the lowest shell (" << before.lowest_shell << ") " << before.shell_over_cover_mm
+                 << " mm over the lowest fingertip cover");
+    CHECK(before.shell_over_cover_mm < 0.0);
+  }
+}
