@@ -6,8 +6,8 @@
 // come at a steady period (a control loop), it wakes itself kLeadNs before the next one is
 // due and polls until kWindowNs after it, so the loop's sends find it awake and pay no
 // system call at all; a burst that misses the window wakes it through the eventfd as usual.
-// While it follows such a schedule it runs SCHED_FIFO 1 where the process may (like the
-// simulated devices), so it wakes on time on a loaded machine.
+// It runs SCHED_FIFO 1 where the process may (like the simulated devices), so it wakes on time
+// on a loaded machine (mock_reactor.cpp: why not only while it follows a schedule).
 #pragma once
 
 #include <atomic>
