@@ -101,7 +101,6 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   if (r == ArmMotionReason::none && g.stop_on != ArmGoal::stop_none && !contact_fresh(in)) {
     r = ArmMotionReason::no_contact_state;
   }
-  if (r == ArmMotionReason::none && hand_retreating(in)) r = ArmMotionReason::hand_retreat;
   if (r == ArmMotionReason::none && g.frame == ArmGoal::sheet && world_sheet == nullptr) r = ArmMotionReason::no_sheet;
   // The points in the world frame, metres (relative to the measured pose: below, once the tool is set).
   CartesianPath path;
@@ -151,10 +150,16 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
       path.pose[k + 1] = to_pose(world);
     }
   }
-  std::memcpy(s_.offset_p, o.p_m, sizeof(s_.offset_p));
-  std::memcpy(s_.offset_quat, o.quat, sizeof(s_.offset_quat));
   path.pose[0] = to_pose(ik_.tool_pose(q_cmd));
   path.count = g.point_count + 1;
+  // While the hand retreats only a lift goes (away from what it pressed); any other is refused.
+  const bool lift = path_is_lift(path);
+  if (!lift && hand_retreating(in)) {
+    refuse(g.id, ArmMotionReason::hand_retreat);
+    return;
+  }
+  std::memcpy(s_.offset_p, o.p_m, sizeof(s_.offset_p));
+  std::memcpy(s_.offset_quat, o.quat, sizeof(s_.offset_quat));
   set_path_limits(path, PathLimits{g.speed_mm_s * 1e-3, g.accel_mm_s2 * 1e-3, g.angular_speed_rad_s,
                                    g.angular_accel_rad_s2, g.stop_accel_mm_s2 * 1e-3, p_.jerk_mm_s3 * 1e-3,
                                    p_.angular_jerk_rad_s3, p_.stop_jerk_mm_s3 * 1e-3});
@@ -164,6 +169,7 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   s_.tool = g.tool;
   s_.stop_on = g.stop_on;
   s_.stop_fingers = g.stop_fingers;
+  s_.lift = lift ? 1 : 0;
   s_.onsets_at_start = in.contact != nullptr ? in.contact->onsets : 0;
   s_.check_segment = 0;
   s_.check_sigma = 0;
@@ -226,7 +232,7 @@ void ArmMotion::check_path(const CycleInputs& in) noexcept {
 }
 
 void ArmMotion::run(const CycleInputs& in) noexcept {
-  if (s_.phase == ArmMotionStatus::running && hand_retreating(in)) {
+  if (s_.phase == ArmMotionStatus::running && s_.lift == 0 && hand_retreating(in)) {
     begin_stop(ArmMotionStatus::aborted, ArmMotionReason::hand_retreat);
   } else if (s_.phase == ArmMotionStatus::running && s_.stop_on == ArmGoal::contact_onset) {
     if (!contact_fresh(in)) {
@@ -276,7 +282,7 @@ bool ArmMotion::step(const CycleInputs& in) noexcept {
   if (active(s_.phase) && ready != Readiness::ready) {
     finish(ArmMotionStatus::aborted, ready == Readiness::stale ? ArmMotionReason::arm_stale : ArmMotionReason::arm_fault);
   }
-  if (s_.phase == ArmMotionStatus::checking && hand_retreating(in)) {
+  if (s_.phase == ArmMotionStatus::checking && s_.lift == 0 && hand_retreating(in)) {
     finish(ArmMotionStatus::aborted, ArmMotionReason::hand_retreat);  // nothing moved yet
   } else if (s_.phase == ArmMotionStatus::checking) {
     check_path(in);

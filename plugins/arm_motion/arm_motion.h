@@ -26,7 +26,8 @@
 // the same way and ends aborted (contact_stale). The hand's controller retreating, inhibited or
 // stale (CycleInputs::hand_control, whatever the stop condition) decelerates it the same way
 // and ends aborted (hand_retreat); a goal arriving then is refused, one being checked is
-// dropped before anything moved. A stale or faulted arm_state aborts at once
+// dropped before anything moved; except a lift (path_is_lift, goal_check.h: straight up, the
+// orientation kept), the safe direction: accepted, checked and run to its end meanwhile. A stale or faulted arm_state aborts at once
 // and holds the last command (the drive is not following: the driver commands its own safe
 // state); when the arm is ready again the held command is re-seated at the measured angles,
 // so the drive is never sent back to where it was before the fault.
@@ -100,6 +101,7 @@ struct MotionState {
   std::uint8_t tool = 0;
   std::uint8_t stop_on = 0;
   std::uint8_t stop_fingers = 0;
+  std::uint8_t lift = 0;        // the path is a lift (goal_check.h): the hand's retreat does not stop it
   std::uint64_t onsets_at_start = 0;
   double offset_p[3] = {};             // flange -> tool, metres
   double offset_quat[4] = {0, 0, 0, 1};

@@ -1,5 +1,6 @@
 #include "plugins/arm_motion/goal_check.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "plugins/robot_model/robot_layout.h"
@@ -36,6 +37,23 @@ ArmMotionReason check_goal(const ArmGoal& g, const GoalLimits& l) noexcept {
     return ArmMotionReason::bad_limits;
   }
   return ArmMotionReason::none;
+}
+
+bool path_is_lift(const CartesianPath& path) noexcept {
+  if (path.count < 2 || path.count > CartesianPath::kMaxPoints) return false;
+  double turn = 0;
+  for (int k = 0; k + 1 < path.count; ++k) {
+    const PathPose& a = path.pose[k];
+    const PathPose& b = path.pose[k + 1];
+    const double rise_mm = 1000.0 * (b.p_m[2] - a.p_m[2]);
+    const double side_mm = 1000.0 * std::hypot(b.p_m[0] - a.p_m[0], b.p_m[1] - a.p_m[1]);
+    if (!(rise_mm >= 0.0 && side_mm <= rise_mm + kLiftSlackMm)) return false;  // NaN: not a lift
+    double dot = 0;
+    for (int c = 0; c < 4; ++c) dot += a.quat[c] * b.quat[c];
+    turn += 2.0 * std::acos(std::min(1.0, std::abs(dot)));
+  }
+  const double total_mm = 1000.0 * (path.pose[path.count - 1].p_m[2] - path.pose[0].p_m[2]);
+  return total_mm > kLiftSlackMm && turn <= kLiftMaxTurnRad;
 }
 
 }  // namespace crease::arm_motion

@@ -7,6 +7,7 @@
 #include <array>
 
 #include "core/port_types/arm_goal.h"
+#include "plugins/arm_motion/cartesian_path.h"
 
 namespace crease::arm_motion {
 
@@ -34,5 +35,16 @@ struct Workspace {
 // in this order: bad_points (kind, frame, stop_on, point_count), unknown_tool, non_finite,
 // bad_orientation, bad_limits. A stop goal is checked for its kind only.
 [[nodiscard]] ArmMotionReason check_goal(const ArmGoal& goal, const GoalLimits& limits) noexcept;
+
+// A lift: the safe direction, away from the sheet and the table (world +z). True when every
+// segment of PATH (its start, the tool's commanded pose, included) ends no lower than it starts
+// and moves sideways at most as far as it rises, plus kLiftSlackMm (within 45 deg of straight
+// up: the start is the commanded pose, a measured-frame goal's points are off the measured
+// one), the whole path rises more than kLiftSlackMm, and the orientation turns by at most
+// kLiftMaxTurnRad in all (a turn about the tool frame could lower the rest of the hand). Such a
+// motion is the one arm_motion accepts and runs while the hand's controller retreats.
+inline constexpr double kLiftSlackMm = 1.0;
+inline constexpr double kLiftMaxTurnRad = 0.05;
+[[nodiscard]] bool path_is_lift(const CartesianPath& path) noexcept;
 
 }  // namespace crease::arm_motion

@@ -513,9 +513,10 @@ TEST_CASE("the hand's controller retreating, inhibited or stale stops a running 
       double max_decel = 0;
       for (std::size_t i = fired; i < t.pose.size(); ++i) max_decel = std::max(max_decel, t.accel_mm_s2(i));
       CHECK(max_decel <= 1000.0 * 1.01);  // the goal's stop deceleration, not a jump
-      // While the hand is still letting go, a new goal is refused and nothing moves.
+      // While the hand is still letting go, a new goal pressing on is refused and nothing moves
+      // (a lift goes: arm_motion_lift_test.cpp).
       const ArmCommand held = r.last;
-      ArmGoal again = goal_to(ToolFrame::ff_pad, shifted(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)), 0, 0, 10), 12, 50, 500);
+      ArmGoal again = goal_to(ToolFrame::ff_pad, shifted(r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r)), 0, 0, -10), 12, 50, 500);
       r.cycle(&again);
       CHECK(r.motion->status().last_refused_id == 12);
       CHECK(r.motion->status().last_refusal == static_cast<std::uint8_t>(ArmMotionReason::hand_retreat));

@@ -3,7 +3,9 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
+#include <initializer_list>
 
 using namespace crease;
 using namespace crease::arm_motion;
@@ -79,4 +81,29 @@ TEST_CASE("the workspace box holds its faces and refuses what lies beyond or is 
   CHECK(w.contains(in));
   CHECK_FALSE(w.contains(out));
   CHECK_FALSE(w.contains(nan));
+}
+
+// A lift: each segment rises at least as much as it moves sideways (1 mm slack), the whole
+// path more than 1 mm, turning 0.05 rad at most in all.
+TEST_CASE("path_is_lift: straight up or steeper than 45 deg, orientation kept") {
+  const auto path = [](std::initializer_list<std::array<double, 3>> mm, double turn_rad = 0) {
+    CartesianPath p;
+    for (const auto& x : mm) {
+      for (int c = 0; c < 3; ++c) p.pose[p.count].p_m[c] = x[c] / 1000.0;
+      p.pose[p.count].quat[0] = p.count == 0 ? 0.0 : std::sin(turn_rad / 2);  // about x, from the start
+      p.pose[p.count].quat[3] = p.count == 0 ? 1.0 : std::cos(turn_rad / 2);
+      ++p.count;
+    }
+    return p;
+  };
+  CHECK(path_is_lift(path({{0, 0, 0}, {0, 0, 30}})));
+  CHECK(path_is_lift(path({{0, 0, 0}, {0.8, 0, 0}, {20, 0, 30}})));  // the commanded-measured slack, then 34 deg
+  CHECK(path_is_lift(path({{0, 0, 0}, {0, 0, 30}}, 0.04)));
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {0, 0, 30}}, 0.06)));      // turned
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {0, 0, -10}})));           // a press
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {0, 0, -0.1}, {0, 0, 30}})));  // down first
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {32, 0, 30}})));           // flatter than 45 deg
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {0, 0, 0.5}})));           // no rise to speak of
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {0, 0, NAN}})));
+  CHECK_FALSE(path_is_lift(path({{0, 0, 0}})));                        // no motion
 }
