@@ -195,8 +195,12 @@ void ArmMotion::check_path(const CycleInputs& in) noexcept {
     double dsig = 1.0;
     if (len > 0) dsig = std::min(dsig, p_.check_step_mm * 1e-3 / len);
     if (ang > 0) dsig = std::min(dsig, p_.check_step_rad / ang);
+    // Equal steps: the segment in the fewest steps of at most dsig, so no sliver of a step is
+    // left at its end (a joint's rate over a sliver is the IK's own noise, 1e-4 rad, divided
+    // by it: a 30.001 mm lift checked in 5 mm steps refused itself as joint_speed).
+    dsig = 1.0 / std::ceil(1.0 / dsig - 1e-9);
     double sig = s_.check_sigma + dsig;
-    if (sig > 1.0 - 1e-9) sig = 1.0;  // no sliver of a step left at a segment's end
+    if (sig > 1.0 - 1e-9) sig = 1.0;
     const KDL::Frame target = pose_at(path, k, sig);
     double q[kArmJoints];
     std::memcpy(q, s_.q_check, sizeof(q));

@@ -11,7 +11,7 @@
 // goal_check.h, a motion is already active (busy), the arm is not ready, a hand tool frame has
 // no fresh hand_state, a stop condition has no fresh armed contact_state, a sheet-frame goal
 // has no sheet, or a point lies outside the workspace. An accepted goal's path (from the
-// tool frame's commanded pose through its points) is then solved ahead, check_step_mm apart,
+// tool frame's commanded pose through its points) is then solved ahead, in equal steps at most check_step_mm apart,
 // check_samples_per_cycle samples per cycle, while the command stays held: a sample without an
 // IK solution inside the joint limits refuses it as unreachable, a sample needing a joint
 // faster than joint_speed_fraction of its URDF limit as joint_speed. Only then does it run:
