@@ -265,6 +265,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       break;
     case S::finish_open:
     case S::abort_open:
+    case S::abort_reopen:
       hand_posture(kRight, f.open_rad, in, out);
       hand_posture(kLeft, f.open_rad, in, out);
       break;

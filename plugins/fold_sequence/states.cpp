@@ -57,6 +57,7 @@ constexpr std::array<StateInfo, kStateCount> kStatesTable = {{
     {S::abort_stop, S::abort, S::abort_stop, "stop"},
     {S::abort_open, S::abort, S::abort_open, "open"},
     {S::abort_lift, S::abort, S::abort_lift, "lift"},
+    {S::abort_reopen, S::abort, S::abort_reopen, "reopen"},
     {S::abort_park, S::abort, S::abort_park, "park"},
     {S::aborted, S::root, S::aborted, "aborted"},
 }};
@@ -131,8 +132,13 @@ constexpr Row kRows[] = {
     {S::abort_stop, Ev::timeout, Guard::none, S::abort_open, Reason::timeout, "stop timed out"},
     {S::abort_open, Ev::hands_posed, Guard::none, S::abort_lift, C, "hands open"},
     {S::abort_open, Ev::timeout, Guard::none, S::abort_lift, Reason::timeout, "open timed out"},
-    {S::abort_lift, Ev::arms_done, Guard::none, S::abort_park, C, "lift ended"},
-    {S::abort_lift, Ev::timeout, Guard::none, S::abort_park, Reason::timeout, "lift timed out"},
+    {S::abort_lift, Ev::arms_done, Guard::none, S::abort_reopen, C, "lift ended"},
+    {S::abort_lift, Ev::timeout, Guard::none, S::abort_reopen, Reason::timeout, "lift timed out"},
+    // Off the sheet, open again: a hand whose opening pressed a fingertip over its force limit
+    // on the sheet retreated and refused goals while it read over it (force_controller's latch);
+    // lifted, it takes this one, which clears the latch, and arm_motion takes the park after it.
+    {S::abort_reopen, Ev::hands_posed, Guard::none, S::abort_park, C, "hands open, lifted"},
+    {S::abort_reopen, Ev::timeout, Guard::none, S::abort_park, Reason::timeout, "reopen timed out"},
     {S::abort_park, Ev::arms_done, Guard::none, S::aborted, C, "park ended"},
     {S::abort_park, Ev::timeout, Guard::none, S::aborted, Reason::timeout, "park timed out"},
 

@@ -2,7 +2,7 @@
 //
 //   idle ─start─► fold ─────────────────────────────────────────────────────────► done
 //                  shift(a) grasp(b) bend(c) fixate_layer(d) refixate(e) swipe(f) harden(g) finish(h)
-//                  └─ any fault, a timeout ─► abort: stop ► open ► lift ► park ─► aborted
+//                  └─ any fault, a timeout ─► abort: stop ► open ► lift ► reopen ► park ─► aborted
 //
 // A state is a leaf or a superstate (its `initial` child is entered with it). A transition row
 // belongs to a state and fires when its event holds and its guard passes; rows are tried from
@@ -32,7 +32,7 @@ enum class S : std::uint8_t {
   harden, harden_open, harden_lift, harden_approach, harden_contact, harden_press, harden_slide,
   finish, finish_memorize, finish_open, finish_lift, finish_park,
   done,
-  abort, abort_stop, abort_open, abort_lift, abort_park,
+  abort, abort_stop, abort_open, abort_lift, abort_reopen, abort_park,
   aborted,
   count
 };

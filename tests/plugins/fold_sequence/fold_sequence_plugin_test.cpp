@@ -36,7 +36,7 @@ const std::vector<std::string> kHalfPath = {
     "fold/finish/memorize", "fold/finish/open", "fold/finish/lift", "fold/finish/park",
     "done"};
 
-const std::vector<std::string> kRetreat = {"abort/stop", "abort/open", "abort/lift", "abort/park", "aborted"};
+const std::vector<std::string> kRetreat = {"abort/stop", "abort/open", "abort/lift", "abort/reopen", "abort/park", "aborted"};
 
 bool near(double a, double b, double tol = 1e-3) { return std::abs(a - b) <= tol; }
 
@@ -314,6 +314,41 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
     r.command(Command::abort);
     expect_abort(r, Reason::operator_abort);
     CHECK(std::string(r.status().why) == "park ended");
+  }
+}
+
+// Opening a hand pressed on the sheet can drive a fingertip over its force limit: the force
+// controller retreats and refuses goals while it reads over it (here: the right hand refuses
+// from the abort's open on). Once lifted it takes goals again, and the abort opens it again
+// before the park (abort/reopen), so the park is not refused behind the hand's retreat
+// (config.sim_sequence: without the reopen the hand stays at the retreat's 0.15 rad and the
+// park is refused). Still over its limit after the lift, the reopen is refused and the park
+// follows at once (not after a timeout).
+TEST_CASE("the abort opens the hands again once lifted, before the park") {
+  for (const bool still_over : {false, true}) {
+    CAPTURE(still_over);
+    Rig r;
+    start_and_run_to(r, "fold/shift/press");
+    r.command(Command::abort);
+    REQUIRE(r.run_to("abort/open"));
+    r.refuse_hand_goals[kRight] = true;
+    REQUIRE(r.run_to("abort/lift"));
+    const long lifted_from = r.cycles();
+    r.refuse_hand_goals[kRight] = still_over;
+    REQUIRE(r.run_to("abort/reopen"));
+    const long reopen_at = r.cycles();
+    REQUIRE(r.run_to("aborted"));
+    CHECK(r.cycles() - reopen_at < 1000);
+    const auto lifts = r.all(kRight, Sent::arm, lifted_from);
+    REQUIRE(lifts.size() == 2);  // the lift, then the park
+    CHECK(lifts[0]->arm_goal.frame == ArmGoal::measured);
+    CHECK(lifts[1]->arm_goal.frame == ArmGoal::world);
+    const auto opens = r.all(kRight, Sent::hand, lifted_from);
+    REQUIRE(opens.size() == 1);  // the reopen's, after the lift and before the park
+    CHECK(opens[0]->cycle > lifts[0]->cycle);
+    CHECK(opens[0]->cycle < lifts[1]->cycle);
+    CHECK(opens[0]->hand_goal.mode == HandMode::posture);
+    for (float q : opens[0]->hand_goal.target_rad) CHECK(q == 0.0f);  // half.yaml's open_rad
   }
 }
 
