@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "motion_rig.h"
+#include "rt/alloc_guard.h"
 
 using namespace rig;
 
@@ -136,4 +137,25 @@ TEST_CASE("a path just over a whole number of check steps is checked and reached
       CHECK(r.motion->status().reasons[static_cast<int>(ArmMotionReason::joint_speed)] == 0);
     }
   }
+}
+
+TEST_CASE("while the hand retreats, refusing a press and running a lift allocate nothing") {
+  REQUIRE(crease::rt::alloc_hooks_installed());
+  Rig r;
+  for (int i = 0; i < 5; ++i) REQUIRE(r.cycle());
+  const KDL::Frame start = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+  ArmGoal press = goal_to(ToolFrame::ff_pad, shifted(start, 0, 0, -10), 1, 50, 500);
+  ArmGoal lift = measured_lift(2, 30);
+  r.hand_control.mode = HandMode::retreat;
+  r.hand_control.inhibit = HandInhibit::force_limit;
+  const auto before = crease::rt::rt_allocation_count();
+  {
+    crease::rt::ScopedRtMark rt;
+    r.cycle(&press);
+    r.cycle(&lift);
+    r.run_to_end();
+  }
+  CHECK(crease::rt::rt_allocation_count() == before);
+  CHECK(r.motion->status().last_refused_id == 1);
+  CHECK(r.motion->status().state == ArmMotionStatus::reached);
 }
