@@ -11,12 +11,13 @@
 // goal_check.h, a motion is already active (busy), the arm is not ready, a hand tool frame has
 // no fresh hand_state, a stop condition has no fresh armed contact_state, a sheet-frame goal
 // has no sheet, or a point lies outside the workspace. An accepted goal's path (from the
-// tool frame's commanded pose through its points) is then solved ahead, in equal steps at most check_step_mm apart,
-// check_samples_per_cycle samples per cycle, while the command stays held: a sample without an
-// IK solution inside the joint limits refuses it as unreachable, a sample needing a joint
-// faster than joint_speed_fraction of its URDF limit as joint_speed. Only then does it run:
-// each cycle the path profile steps (cartesian_path.h) and the IK tracks the new pose warm
-// from the last command (ArmIk::track); the command's velocity is the step over the cycle.
+// tool frame's commanded pose through its points) is then solved ahead, in equal steps at
+// most check_step_mm apart, check_samples_per_cycle samples per cycle, while the command
+// stays held: a sample without an IK solution inside the joint limits refuses it as
+// unreachable, a sample needing a joint faster than joint_speed_fraction of its URDF limit as
+// joint_speed. Only then does it run: each cycle the path profile steps (cartesian_path.h)
+// and the IK tracks the new pose warm from the last command (ArmIk::track); the command's
+// velocity is the step over the cycle.
 //
 // A goal in the `measured` frame is relative to the tool frame's measured pose when it arrives
 // (the forward kinematics of arm_state's angles): a lift from where the arm is.
@@ -27,10 +28,11 @@
 // stale (CycleInputs::hand_control, whatever the stop condition) decelerates it the same way
 // and ends aborted (hand_retreat); a goal arriving then is refused, one being checked is
 // dropped before anything moved; except a lift (path_is_lift, goal_check.h: straight up, the
-// orientation kept), the safe direction: accepted, checked and run to its end meanwhile. A stale or faulted arm_state aborts at once
-// and holds the last command (the drive is not following: the driver commands its own safe
-// state); when the arm is ready again the held command is re-seated at the measured angles,
-// so the drive is never sent back to where it was before the fault.
+// orientation kept), the safe direction: accepted, checked and run to its end meanwhile.
+// A stale or faulted arm_state aborts at once and holds the last command (the drive is not
+// following: the driver commands its own safe state); when the arm is ready again the held
+// command is re-seated at the measured angles, so the drive is never sent back to where it
+// was before the fault.
 // Holding: with nothing running the command is the last one, unchanged, every cycle.
 // The whole state is plain data (save_state / load_state: a motion carried across a hot-swap).
 #pragma once
@@ -101,7 +103,7 @@ struct MotionState {
   std::uint8_t tool = 0;
   std::uint8_t stop_on = 0;
   std::uint8_t stop_fingers = 0;
-  std::uint8_t lift = 0;        // the path is a lift (goal_check.h): the hand's retreat does not stop it
+  std::uint8_t lift = 0;        // a lift (goal_check.h): the hand's retreat does not stop it
   std::uint64_t onsets_at_start = 0;
   double offset_p[3] = {};             // flange -> tool, metres
   double offset_quat[4] = {0, 0, 0, 1};
