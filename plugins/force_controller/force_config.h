@@ -18,6 +18,12 @@ inline constexpr int kForceFingers = 4;  // the thumb is never force controlled 
 
 enum class OnBadInput : std::uint8_t { hold, retreat };
 
+inline constexpr std::array<double, kJoints> filled(double v) noexcept {
+  std::array<double, kJoints> a{};
+  for (double& x : a) x = v;
+  return a;
+}
+
 struct ForceConfig {
   robot::TactileKind sensor = robot::TactileKind::pst;  // pst: hand_state pressures; taxel_matrix: `tactile`
   double kpa_per_n = 10.0;       // PST calibration (robot YAML)
@@ -31,7 +37,9 @@ struct ForceConfig {
   double max_flex_rad = 0.6;      // saturation: flexion beyond the force mode's starting pose
   double max_rate_rad_s = 1.0;    // every commanded joint, every mode
   double retreat_rad = 0.15;      // a retreat extends every finger's flexion joints by this
-  double default_stiffness = 2.0; // N m/rad, until a posture goal sets others
+  // N m/rad per joint, until a posture goal sets others: `default_stiffness` for every joint,
+  // `joint_stiffness` by name over it (a wrist held stiff while the fingers press softly).
+  std::array<double, kJoints> default_stiffness = filled(2.0);
   double force_limit_n = 5.0;     // hard limit per fingertip: exceeded -> retreat, fault event
   double max_goal_force_n = 4.0;  // goals above are refused (< force_limit_n)
   double settle_band = 0.05;      // |error| <= band x goal (and >= settle_band_n) ...

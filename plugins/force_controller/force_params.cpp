@@ -47,6 +47,25 @@ std::array<double, kJoints> read_alpha(const Params& p) {
   return out;
 }
 
+// default_stiffness for every joint, joint_stiffness {NAME: N m/rad} over it.
+std::array<double, kJoints> read_stiffness(const Params& p) {
+  std::array<double, kJoints> out = filled(p.get_in_range<double>("default_stiffness", 2.0, 0.0, 655.35));
+  if (!p.has("joint_stiffness")) return out;
+  const YAML::Node node = p.raw("joint_stiffness");
+  const Params map = p.child("joint_stiffness");
+  const std::vector<std::string> names(robot::kHandJointNames.begin(), robot::kHandJointNames.end());
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    const std::string name = it->first.as<std::string>();
+    const int j = robot::hand_joint_index(name);
+    if (j < 0) {
+      const std::string guess = config::did_you_mean(name, names);
+      map.fail(name, "unknown joint '" + name + "'" + (guess.empty() ? "" : " (did you mean '" + guess + "'?)"));
+    }
+    out[static_cast<std::size_t>(j)] = map.get_in_range<double>(name, 0.0, 0.0, 655.35);
+  }
+  return out;
+}
+
 }  // namespace
 
 ForceConfig read_force_config(const Params& p) {
@@ -73,7 +92,7 @@ ForceConfig read_force_config(const Params& p) {
   c.max_flex_rad = p.get_in_range<double>("max_flex_rad", c.max_flex_rad, 0.0, 3.0);
   c.max_rate_rad_s = p.get_in_range<double>("max_rate_rad_s", c.max_rate_rad_s, 1e-3, 20.0);
   c.retreat_rad = p.get_in_range<double>("retreat_rad", c.retreat_rad, 0.0, 1.5);
-  c.default_stiffness = p.get_in_range<double>("default_stiffness", c.default_stiffness, 0.0, 655.35);
+  c.default_stiffness = read_stiffness(p);
   c.force_limit_n = p.get_in_range<double>("force_limit_n", c.force_limit_n, 0.01, 100.0);
   c.max_goal_force_n = p.get_in_range<double>("max_goal_force_n", 0.8 * c.force_limit_n, 0.0, 100.0);
   if (!(c.max_goal_force_n < c.force_limit_n)) p.fail("max_goal_force_n", "must be below force_limit_n");

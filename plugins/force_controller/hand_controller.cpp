@@ -251,7 +251,7 @@ bool HandController::step_rt(const ForceInputs& in, HandCommand& command, HandCo
     // The first healthy state: hold the hand where it is (no jump), tare the PST sensors.
     for (int j = 0; j < kJoints; ++j) {
       s_.cmd[sz(j)] = in.hand->position_rad[j];
-      s_.stiffness[sz(j)] = static_cast<float>(c_.default_stiffness);
+      s_.stiffness[sz(j)] = static_cast<float>(c_.default_stiffness[sz(j)]);
     }
     for (int f = 0; f < kFingers; ++f) s_.baseline_kpa[sz(f)] = in.hand->pressure_kpa[f];
     s_.commanding = 1;

@@ -8,6 +8,7 @@ namespace {
 
 constexpr int kN = HandCompliance::kJoints;
 constexpr int kMaxRounds = 100;
+constexpr double kAtBoundRad = 1e-9;   // a joint this near a bound is at it (the last step's rounding)
 constexpr double kEpsNmmPerRad = 1e-2;  // keeps a joint nothing holds solvable (0.01 N mm per rad: nothing)
 // In-place Cholesky solve of the SPD system A x = b (A overwritten). False if not SPD.
 bool cholesky_solve(double a[kN][kN], double b[kN]) noexcept {
@@ -37,10 +38,22 @@ bool cholesky_solve(double a[kN][kN], double b[kN]) noexcept {
 
 }  // namespace
 
+void HandCompliance::configure(const Limits& limits, int max_contacts) {
+  limits_ = limits;
+  g_.assign(static_cast<std::size_t>(std::max(0, max_contacts)), Joints{});
+  on_.assign(g_.size(), 0);
+  truncated_ = 0;
+}
+
 void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact> contacts, const Joints& target,
                               const Joints& stiffness, const Joints& tau_external, bool compliant, Joints& dq,
                               std::span<double> force_n) noexcept {
-  const int nc = std::min<int>(static_cast<int>(contacts.size()), kMaxContacts);
+  const int given = static_cast<int>(contacts.size());
+  const int nc = std::min(given, capacity());
+  if (given > nc) {
+    ++truncated_;
+    for (int c = nc; c < given; ++c) force_n[c] = 0.0;
+  }
   for (int c = 0; c < nc; ++c) {
     g_[c].fill(0.0);
     kin.add_hand_jacobian_transpose(contacts[c].link, contacts[c].point, contacts[c].normal, g_[c]);
@@ -55,113 +68,157 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     return;
   }
   const Joints old = dq;
-  enum State : unsigned char { free_joint, locked };
-  State st[kN];
-  double lock_at[kN], k_eff[kN], k_full[kN], tmax[kN];
+  // The box each joint's deflection stays in: its limits, and within max_step_rad of the last.
+  double lo[kN], hi[kN], k_full[kN], tmax[kN], k_eff[kN];
   for (int j = 0; j < kN; ++j) {
-    st[j] = free_joint;
-    lock_at[j] = 0;
-    k_full[j] = k_eff[j] = 1000.0 * std::max(0.0, stiffness[j]);
+    lo[j] = std::max(limits_.lower_rad[j] - target[j], old[j] - max_step_rad_);
+    hi[j] = std::min(limits_.upper_rad[j] - target[j], old[j] + max_step_rad_);
+    if (lo[j] > hi[j]) lo[j] = hi[j] = std::clamp(old[j], limits_.lower_rad[j] - target[j], limits_.upper_rad[j] - target[j]);
+    k_full[j] = 1000.0 * std::max(0.0, stiffness[j]);
     tmax[j] = 1000.0 * limits_.effort_nm[j];
   }
-  bool on[kMaxContacts];
-  for (int c = 0; c < nc; ++c) on[c] = contacts[c].depth_mm > 0;
-  // Depth of contact c at deflection dq, linearised about the step's.
-  auto depth = [&](int c, const Joints& d) {
-    double s = contacts[c].depth_mm;
-    for (int j = 0; j < kN; ++j) s += g_[c][j] * (d[j] - old[j]);
-    return s;
+  // Depth of contact c at deflection d, linearised about the step's.
+  auto depth = [&](int c, const double* d) {
+    double v = contacts[c].depth_mm;
+    for (int j = 0; j < kN; ++j) v += g_[c][j] * (d[j] - old[j]);
+    return v;
+  };
+  // The potential the balance minimises (N mm): the springs (quadratic up to the effort, linear
+  // beyond: convex), the covers' compression 1/2 k d^2, less the external torques' work.
+  auto energy = [&](const double* d) {
+    double e = 0;
+    for (int j = 0; j < kN; ++j) {
+      const double x = std::fabs(d[j]), xs = k_full[j] > 0 ? tmax[j] / k_full[j] : 0.0;
+      e += 0.5 * kEpsNmmPerRad * x * x - tau_external[j] * d[j];
+      if (k_full[j] > 0) e += x <= xs ? 0.5 * k_full[j] * x * x : tmax[j] * (x - 0.5 * xs);
+    }
+    for (int c = 0; c < nc; ++c) {
+      const double v = depth(c, d);
+      if (v > 0) e += 0.5 * contacts[c].stiffness_n_per_mm * v * v;
+    }
+    return e;
   };
 
-  Joints sol = old;
+  double cur[kN];
+  for (int j = 0; j < kN; ++j) cur[j] = std::clamp(old[j], lo[j], hi[j]);
+  double e_cur = energy(cur);
+  std::uint8_t* on = on_.data();
+  bool locked[kN] = {};
   rounds_ = 0;
   failed_ = false;
+  // Projected Newton on the convex potential: each round linearises at the current point (the
+  // contacts pressing there, each spring at its secant stiffness there, joints held at a bound
+  // they push against), solves, and backtracks along the way to the solution until the
+  // potential falls, so the active sets cannot cycle.
   for (int round = 0; round < kMaxRounds; ++round) {
     ++rounds_;
-    double a[kN][kN] = {};
-    double r[kN];
+    for (int c = 0; c < nc; ++c) on[c] = depth(c, cur) > 0;
+    double grad[kN];
     for (int j = 0; j < kN; ++j) {
-      r[j] = tau_external[j];
-      a[j][j] = kEpsNmmPerRad + k_eff[j];
+      k_eff[j] = std::fabs(k_full[j] * cur[j]) <= tmax[j] ? k_full[j] : tmax[j] / std::fabs(cur[j]);
+      grad[j] = (kEpsNmmPerRad + k_eff[j]) * cur[j] - tau_external[j];
     }
     for (int c = 0; c < nc; ++c) {
       if (!on[c]) continue;
-      const double kc = contacts[c].stiffness_n_per_mm;
-      double gd = 0;
-      for (int j = 0; j < kN; ++j) gd += g_[c][j] * old[j];
-      const double rc = -kc * (contacts[c].depth_mm - gd);
-      for (int i = 0; i < kN; ++i) {
-        const double gi = g_[c][i];
-        if (gi == 0.0) continue;
-        r[i] += rc * gi;
-        for (int j = 0; j < kN; ++j) a[i][j] += kc * gi * g_[c][j];
-      }
+      const double f = contacts[c].stiffness_n_per_mm * depth(c, cur);
+      for (int j = 0; j < kN; ++j) grad[j] += f * g_[c][j];
     }
-    for (int j = 0; j < kN; ++j) {
-      if (st[j] != locked) continue;
-      for (int i = 0; i < kN; ++i) {
-        if (i == j) continue;
-        r[i] -= a[i][j] * lock_at[j];
-        a[i][j] = a[j][i] = 0.0;
+    // A joint at a bound stays there while the potential falls beyond it.
+    for (int j = 0; j < kN; ++j) locked[j] = (cur[j] <= lo[j] + kAtBoundRad && grad[j] > 0) || (cur[j] >= hi[j] - kAtBoundRad && grad[j] < 0);
+
+    // The Newton step over the free joints. A free joint at a bound that the step would take
+    // past it is held there too, and the step solved again: what is left descends.
+    double r[kN];
+    bool solved = false;
+    for (int again = 0; again <= kN; ++again) {
+      double a[kN][kN] = {};
+      for (int j = 0; j < kN; ++j) {
+        r[j] = tau_external[j];
+        a[j][j] = kEpsNmmPerRad + k_eff[j];
       }
-      a[j][j] = 1.0;
-      r[j] = lock_at[j];
+      for (int c = 0; c < nc; ++c) {
+        if (!on[c]) continue;
+        const double kc = contacts[c].stiffness_n_per_mm;
+        double gd = 0;
+        for (int j = 0; j < kN; ++j) gd += g_[c][j] * old[j];
+        const double rc = -kc * (contacts[c].depth_mm - gd);
+        for (int i = 0; i < kN; ++i) {
+          const double gi = g_[c][i];
+          if (gi == 0.0) continue;
+          r[i] += rc * gi;
+          for (int j = 0; j < kN; ++j) a[i][j] += kc * gi * g_[c][j];
+        }
+      }
+      for (int j = 0; j < kN; ++j) {
+        if (!locked[j]) continue;
+        for (int i = 0; i < kN; ++i) {
+          if (i == j) continue;
+          r[i] -= a[i][j] * cur[j];
+          a[i][j] = a[j][i] = 0.0;
+        }
+        a[j][j] = 1.0;
+        r[j] = cur[j];
+      }
+      if (!cholesky_solve(a, r)) break;  // lost to rounding (A is SPD by construction)
+      solved = true;
+      bool more = false;
+      for (int j = 0; j < kN; ++j) {
+        if (locked[j]) continue;
+        if ((cur[j] <= lo[j] + kAtBoundRad && r[j] < cur[j]) || (cur[j] >= hi[j] - kAtBoundRad && r[j] > cur[j])) {
+          locked[j] = true;
+          more = true;
+        }
+      }
+      if (!more) break;
+      solved = false;
     }
-    if (!cholesky_solve(a, r)) {  // lost to rounding (A is SPD by construction): the last iterate
+    if (!solved) {  // keep the iterate
       failed_ = true;
       break;
     }
-    for (int j = 0; j < kN; ++j) sol[j] = r[j];
-
-    bool changed = false;
-    for (int c = 0; c < nc; ++c) {
-      const double d = depth(c, sol);
-      if (on[c] != (d > 0)) {
-        on[c] = d > 0;
-        changed = true;
+    double next[kN], step = 0;
+    for (double t = 1.0; t > 1e-6; t *= 0.5) {
+      for (int j = 0; j < kN; ++j) next[j] = std::clamp(cur[j] + t * (r[j] - cur[j]), lo[j], hi[j]);
+      const double e = energy(next);
+      if (e <= e_cur) {
+        step = 0;
+        for (int j = 0; j < kN; ++j) step = std::max(step, std::fabs(next[j] - cur[j]));
+        for (int j = 0; j < kN; ++j) cur[j] = next[j];
+        e_cur = e;
+        break;
       }
     }
-    // The torque the contacts, the external load and the spring leave on each joint at the
-    // solution: a joint at a limit stays there while it pushes into it.
-    double net[kN];
-    for (int j = 0; j < kN; ++j) net[j] = tau_external[j] - k_eff[j] * sol[j];
-    for (int c = 0; c < nc; ++c) {
-      if (!on[c]) continue;
-      const double f = contacts[c].stiffness_n_per_mm * depth(c, sol);
-      for (int j = 0; j < kN; ++j) net[j] -= f * g_[c][j];
-    }
-    for (int j = 0; j < kN; ++j) {
-      if (st[j] == locked) {
-        const bool at_upper = target[j] + lock_at[j] >= limits_.upper_rad[j];
-        if (at_upper ? net[j] < 0 : net[j] > 0) {
-          st[j] = free_joint;
-          changed = true;
+    if (step <= 1e-12) {
+      // No descent. A free joint that the step takes out through a bound it is all but at
+      // (closer than the smallest trial step moves it) bends the projected way uphill: put it
+      // on that bound, where the next round holds it, and go on; else this is the minimum.
+      bool snapped = false;
+      for (int j = 0; j < kN; ++j) {
+        if (locked[j]) continue;
+        const double d = r[j] - cur[j];
+        if (d < 0 && cur[j] - lo[j] < 1e-3 * -d) {
+          cur[j] = lo[j];
+          snapped = true;
+        } else if (d > 0 && hi[j] - cur[j] < 1e-3 * d) {
+          cur[j] = hi[j];
+          snapped = true;
         }
-        continue;
       }
-      const double q = target[j] + sol[j];
-      if (q < limits_.lower_rad[j] || q > limits_.upper_rad[j]) {
-        st[j] = locked;
-        lock_at[j] = std::clamp(q, limits_.lower_rad[j], limits_.upper_rad[j]) - target[j];
-        changed = true;
-        continue;
-      }
-      // The spring saturates at the effort: its secant stiffness there, converging from above
-      // (a softening spring: each round's deflection is at most the next one's).
-      const double k = std::fabs(k_full[j] * sol[j]) <= tmax[j] ? k_full[j] : tmax[j] / std::fabs(sol[j]);
-      if (std::fabs(k - k_eff[j]) > 1e-9 * (k_full[j] + 1.0)) {
-        k_eff[j] = k;
-        changed = true;
-      }
+      if (!snapped) break;
+      e_cur = energy(cur);
     }
-    if (!changed) break;
   }
-  dq = sol;
+  for (int j = 0; j < kN; ++j) dq[j] = cur[j];
+  saturated_ = 0;
+  at_limit_ = 0;
   for (int j = 0; j < kN; ++j) {
-    saturated_ += st[j] != locked && k_eff[j] < k_full[j];
-    at_limit_ += st[j] == locked;
+    const double q = target[j] + cur[j];
+    // At a limit and pushing into it (as the last round found it).
+    const bool at = locked[j] && (q <= limits_.lower_rad[j] + 1e-12 || q >= limits_.upper_rad[j] - 1e-12);
+    at_limit_ += at;
+    saturated_ += !at && std::fabs(k_full[j] * cur[j]) > tmax[j];
   }
-  for (int c = 0; c < nc; ++c) force_n[c] = on[c] ? contacts[c].stiffness_n_per_mm * std::max(0.0, depth(c, sol)) : 0.0;
+  for (int c = 0; c < nc; ++c) force_n[c] = contacts[c].stiffness_n_per_mm * std::max(0.0, depth(c, cur));
 }
 
 }  // namespace crease::world

@@ -19,6 +19,10 @@ void require(bool ok, const char* key, const char* why) {
 // A hand shape this far above the table still enters the balance: a finger deflected by what
 // it touched springs back up to the joint limits' reach (~30 mm at a fingertip) if that goes.
 constexpr double kTableGapMm = 50.0;
+// The most a hand joint's deflection changes in one step (rad; 50 rad/s, far beyond the drives'
+// 2 rad/s): the balance's contacts are linear about the step's pose, and a stiff shell's gap
+// predicted to close by a large turn flung the hand about step after step.
+constexpr double kMaxDeflectionStepRad = 0.05;
 
 bool finite_all(const World::HandJoints& a) {
   for (double v : a)
@@ -93,7 +97,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
       h.stiffness[j] = h.stiffness_cmd[j] = params_.initial_stiffness_nm_per_rad;
     }
     compliance_[s] = std::make_unique<HandCompliance>();
-    compliance_[s]->configure(lim);
+    compliance_limits_[s] = lim;  // configured below, once the contacts' worst case is known
     const std::string& prefix = model.params().side(side).prefix;
     for (int f = 0; f < robot::kFingertips; ++f) {
       h.tip_link[f] = kin_[s]->link_index(prefix + std::string(robot::kFingertipNames[f]) + "pad");
@@ -121,6 +125,8 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
     hand_contact_shape_[s].resize(cap);
     hand_contact_shape2_[s].resize(cap);
     hand_contact_force_[s].resize(cap);
+    compliance_[s]->configure(compliance_limits_[s], static_cast<int>(cap));
+    compliance_[s]->set_max_step_rad(kMaxDeflectionStepRad);
   }
   shape_normal_n_.assign(shapes_.size(), 0.0);
   shape_normal_vec_n_.assign(shapes_.size(), Vec3{});

@@ -57,7 +57,8 @@ struct Side {
       stiff = stiff && c.enable == 1;
       for (int j = 0; j < HandCommand::kJoints; ++j) {
         hand_change_rad = std::max(hand_change_rad, std::fabs(c.target_rad[j] - first.target_rad[j]));
-        stiff = stiff && c.stiffness_nm_per_rad[j] == 2.0f;  // force_X's default_stiffness
+        // force_X's default_stiffness, its joint_stiffness on the wrist (WRJ2, WRJ1)
+        stiff = stiff && c.stiffness_nm_per_rad[j] == (j < 2 ? 30.0f : 2.0f);
       }
     }
     if (arm_command.poll().has_data()) {

@@ -170,6 +170,19 @@ TEST_CASE("start: limp (the default): enable 0 following the hand until a goal, 
   }
 }
 
+TEST_CASE("joint_stiffness holds the named joints at their own stiffness from the first state, the rest at default_stiffness") {
+  Rig r(config("start: hold, default_stiffness: 1.5, joint_stiffness: {WRJ2: 30, WRJ1: 25}"));
+  r.steps(5);
+  REQUIRE(r.cmd.enable == 1);
+  CHECK(r.cmd.stiffness_nm_per_rad[0] == 30.0f);  // WRJ2 (drivers/README.md §3)
+  CHECK(r.cmd.stiffness_nm_per_rad[1] == 25.0f);  // WRJ1
+  for (int j = 2; j < kJoints; ++j) CHECK(r.cmd.stiffness_nm_per_rad[j] == 1.5f);
+  // Without it every joint at default_stiffness.
+  Rig plain(config("start: hold, default_stiffness: 1.5"));
+  plain.steps(5);
+  for (int j = 0; j < kJoints; ++j) CHECK(plain.cmd.stiffness_nm_per_rad[j] == 1.5f);
+}
+
 TEST_CASE("Eq. 6 presses the finger to 0.5 N and 2 N and holds it; settled is reported (failing variant: k_P = 0)") {
   for (const double k_p : {2.0, 0.0}) {
     for (const double target : {0.5, 2.0}) {
@@ -480,6 +493,10 @@ TEST_CASE("parameters: bad ones are refused with file, line and key") {
   CHECK(error_of("alpha: {FFJ3: 0.2, FFJ2: 0.5}").find("force.params.alpha.FFJ2: alpha of FFJ2 must not exceed") !=
         std::string::npos);
   CHECK(error_of("alpha: {FFJ3: -1}").find("force.params.alpha.FFJ3: must be in [0, 10]") != std::string::npos);
+  CHECK(error_of("joint_stiffness: {WRJ3: 20}").find("force.params.joint_stiffness.WRJ3: unknown joint 'WRJ3' (did you mean") !=
+        std::string::npos);
+  CHECK(error_of("joint_stiffness: {WRJ1: 700}").find("force.params.joint_stiffness.WRJ1: must be in [0, 655.35]") !=
+        std::string::npos);
   CHECK(error_of("k_p: -2").find("f.yaml:1:") == 0);
   CHECK(error_of("k_p: -2").find("force.params.k_p: must be in [0, 100], got -2") != std::string::npos);
   CHECK(error_of("on_bad_input: panic").find("force.params.on_bad_input: expected hold or retreat") != std::string::npos);

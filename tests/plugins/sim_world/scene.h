@@ -18,6 +18,7 @@
 #include "plugins/robot_model/robot_model.h"
 #include "plugins/sim_world/reference_poses.h"
 #include "plugins/sim_world/sim_world.h"
+#include "plugins/sim_world/world_config.h"
 
 namespace scene {
 
@@ -65,7 +66,8 @@ class ArmIk {
   // Arm angles putting link TOOL's origin (without prefix) at p_mm with the palm turned to
   // PALM, the hand at HAND, starting from GUESS (then, if that ends outside the limits or short
   // of the pose, from a fixed grid of guesses over the shoulder, elbow and wrist: the first
-  // within both). Fails the test when none reaches it within TOL_MM (0.01 mm) within the limits.
+  // within both). Fails the test when none reaches it within TOL_MM (0.01 mm) and kTolRad within
+  // the limits.
   ArmQ solve(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess,
              double tol_mm = 0.01) {
     Attempt a = attempt(tool, p_mm, palm, hand, guess);
@@ -73,13 +75,14 @@ class ArmIk {
       for (double s2 : {0.5, 0.2, 0.8, -0.3, 1.2})
         for (double e1 : {1.4, 0.8, 2.0, 2.3})
           for (double w1 : {1.2, 0.6, -0.6, 1.6}) {
-            if (a.within_limits && a.err_mm < tol_mm) break;
+            if (a.within_limits && a.reached(tol_mm)) break;
             a = attempt(tool, p_mm, palm, hand, {s1, s2, 0.0, e1, 0.0, w1, 0.0});
           }
-    if (!(a.err_mm < tol_mm && a.within_limits))
-      std::printf("ik: %s at (%.1f, %.1f, %.1f) mm: rc %d err %.4f mm, within limits %d\n", tool.c_str(), p_mm.x, p_mm.y,
-                  p_mm.z, a.rc, a.err_mm, static_cast<int>(a.within_limits));
+    if (!(a.reached(tol_mm) && a.within_limits))
+      std::printf("ik: %s at (%.1f, %.1f, %.1f) mm: rc %d err %.4f mm %.2g rad, within limits %d\n", tool.c_str(), p_mm.x,
+                  p_mm.y, p_mm.z, a.rc, a.err_mm, a.err_rad, static_cast<int>(a.within_limits));
     REQUIRE(a.err_mm < tol_mm);
+    REQUIRE(a.err_rad < kTolRad);
     for (int i = 0; i < robot::kArmJoints; ++i) {
       REQUIRE(a.q[i] >= lo_[i]);
       REQUIRE(a.q[i] <= hi_[i]);
@@ -93,9 +96,12 @@ class ArmIk {
   struct Attempt {
     ArmQ q{};
     double err_mm = 0;
+    double err_rad = 0;  // the flange's turn from the goal's
     bool within_limits = false;
     int rc = 0;
+    [[nodiscard]] bool reached(double tol_mm) const { return err_mm < tol_mm && err_rad < kTolRad; }
   };
+  static constexpr double kTolRad = 1e-4;  // the palm's orientation: 0.006 deg
   Attempt attempt(const std::string& tool, Vec3 p_mm, const KDL::Rotation& palm, const HandQ& hand, const ArmQ& guess) {
     const int t = kin_->link_index(prefix_ + tool), pl = kin_->link_index(prefix_ + "palm");
     REQUIRE(t >= 0);
@@ -121,6 +127,8 @@ class ArmIk {
     KDL::Frame reached;
     REQUIRE(fk_->JntToCart(q, reached) >= 0);
     a.err_mm = 1000.0 * (reached.p - goal.p).Norm();
+    KDL::Vector axis;
+    a.err_rad = std::fabs((reached.M.Inverse() * goal.M).GetRotAngle(axis));
     return a;
   }
 
@@ -145,16 +153,17 @@ using poses::index_out;
 inline KDL::Rotation palm_forward_down(robot::Side, double beta) { return poses::palm_forward_down(beta); }
 
 // A world with the working hand's tool TOOL at START (palm turned PALM, hand HAND) and the
-// other hand parked high beside the table; the nominal world unless PARAMS says otherwise.
+// other hand parked beside the table; the nominal world unless PARAMS says otherwise.
 struct Rig {
   Rig(WorldParams p, const std::string& tool_, Vec3 start, const KDL::Rotation& palm_, const HandQ& hand,
       robot::Side side_ = robot::Side::right)
-      : params(std::move(p)), side(side_), ik(robot_model(), side_), ik_other(robot_model(), other(side_)),
+      : params(std::move(p)), side(side_), ik(robot_model(), side_),
         tool(tool_), palm(palm_), hand_q(hand), last(start) {
-    const double sx = side == robot::Side::right ? -1.0 : 1.0;  // the other side's x sign
     q = ik.solve(tool, start, palm, hand_q, arm_guess());
-    q_other = ik_other.solve("palm", {400 * sx, -150, 300}, frame_from_z_x({0, 0, -1}, {-sx, 0, 0}), other_hand,
-                             arm_guess());
+    // The other arm parked as creased parks it (sim_world's default: its pad 300 mm over the
+    // table beside the sheet).
+    const int parked = 1 - static_cast<int>(side);
+    for (int j = 0; j < robot::kArmJoints; ++j) q_other[j] = world::kParkedArmDeg[parked][j] * std::numbers::pi / 180.0;
     const int me = static_cast<int>(side), them = static_cast<int>(other(side));
     params.initial_arm_rad[me] = q;
     params.initial_arm_rad[them] = q_other;
@@ -203,7 +212,7 @@ struct Rig {
 
   WorldParams params;
   robot::Side side;
-  ArmIk ik, ik_other;
+  ArmIk ik;
   std::string tool;
   KDL::Rotation palm;
   HandQ hand_q{}, other_hand{}, stiffness{}, other_stiffness{};

@@ -49,7 +49,7 @@ struct Arm {
         for (double e1 : {1.4, 0.8, 2.0, 2.3})
           for (double w1 : {1.2, 0.6, -0.6, 1.6}) {
             const ArmIk::Attempt t = ik.attempt(tool, at, palm, q, {s1, s2, 0.0, e1, 0.0, w1, 0.0});
-            if (t.within_limits && t.err_mm < 0.01) {
+            if (t.within_limits && t.reached(0.01)) {
               arm = t.q;
               return;
             }
