@@ -16,6 +16,10 @@ struct TactileHostConfig {
   std::uint16_t rate_hz = 250;
   std::int64_t max_age_ns = 20'000'000;  // older than this: fault
   std::int64_t start_retry_ns = 100'000'000;
+  // TactileReader's thread: SCHED_FIFO at this priority where the process may (0: it keeps
+  // the policy it inherits). Its work per wake-up is bounded (one read, deframing), so it may
+  // preempt every non-real-time thread without starving them; below the loops.
+  int thread_priority = 1;
 };
 
 // The health of a tactile link (TactileHost's and TactileReader's): no sample yet, or the

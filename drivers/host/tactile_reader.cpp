@@ -1,5 +1,8 @@
 #include "drivers/host/tactile_reader.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include "rt/clock.h"
 #include "rt/thread_placement.h"
 
@@ -21,6 +24,7 @@ void TactileReader::stop() {
   stop_.store(true, std::memory_order_release);
   io_->wake();
   thread_.join();
+  fifo_.store(false, std::memory_order_release);
 }
 
 void TactileReader::send_start(std::int64_t now_ns) {
@@ -38,6 +42,16 @@ void TactileReader::send_start(std::int64_t now_ns) {
 
 void TactileReader::run() {
   rt::place_this_thread_non_rt(name_);
+  // Real-time where permitted, when it inherited the default policy (a thread made by a loop
+  // keeps the loop's; tactile_reader.h says why).
+  int inherited = SCHED_OTHER;
+  sched_param param{};
+  (void)pthread_getschedparam(pthread_self(), &inherited, &param);
+  if (inherited == SCHED_OTHER && cfg_.thread_priority > 0) {
+    sched_param sp{};
+    sp.sched_priority = cfg_.thread_priority;
+    fifo_.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_release);
+  }
   last_start_ns_ = rt::now_ns() - cfg_.start_retry_ns;  // the first Start goes out at once
   while (!stop_.load(std::memory_order_acquire)) {
     std::int64_t now = rt::now_ns();

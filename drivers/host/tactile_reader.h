@@ -1,7 +1,8 @@
 // TactileReader: the tactile matrix's serial link (drivers/README.md §6) served by a
 // non-real-time thread of its own, so that a loop's update never makes a syscall on the tty.
 //
-//   thread (named, on the non-RT CPUs: rt/thread_placement.h)   update (RT)
+//   thread (named, on the non-RT CPUs: rt/thread_placement.h;   update (RT)
+//   SCHED_FIFO cfg.thread_priority where permitted)
 //     wait for bytes (SerialIo::read_wait), deframe, decode   take_rt(now): pops every queued
 //     each Sample -> queue (rt/queue.h, SPSC, kQueueCapacity)   sample, keeps the newest
 //     Start while no sample arrives (and every retry period)    health(now), counters()
@@ -11,6 +12,11 @@
 // (256 ms at 250 Hz) drops the newer ones, counted as overruns. A sample's reception time is
 // the time of the RT side's call that took it (the loop's clock, as the rest of a cycle's
 // state), so its age and the link's health are in the loop's time.
+// Why real-time: at SCHED_OTHER the thread waited behind the process's own renderers and the
+// machine's other work, and config.sim_sequence saw the taxels 100 ms and more old (a link
+// fault to contact_r, the folding sequence aborted) while the world wrote them on time. The
+// thread blocks in poll() between samples (woken by the bytes, or by stop), so it costs a CPU
+// only for the read and the deframing.
 #pragma once
 
 #include <atomic>
@@ -60,6 +66,9 @@ class TactileReader {
   [[nodiscard]] TactileCounters counters() const noexcept;
   // Any thread: whether the thread has sent a Start yet (its write went through).
   [[nodiscard]] bool started() const noexcept { return started_.load(std::memory_order_acquire); }
+  // Any thread: whether the running thread took SCHED_FIFO cfg.thread_priority (false while
+  // it has not tried yet, was not permitted, or the priority is 0).
+  [[nodiscard]] bool fifo() const noexcept { return fifo_.load(std::memory_order_acquire); }
 
  private:
   struct Record {
@@ -84,6 +93,7 @@ class TactileReader {
   std::atomic<std::uint64_t> framing_errors_{0};
   std::atomic<std::uint64_t> taken_shared_{0};
   std::atomic<bool> started_{false};
+  std::atomic<bool> fifo_{false};
   std::atomic<bool> stop_{false};
   std::thread thread_;
   // The RT side's own.

@@ -16,10 +16,13 @@
 //                   with bus_prefix is the simulated robot's link of that name
 //                   (drivers/host/bus_prefix.h: simulated_link_path, made by sim_world)
 //   tactile_rate_hz 1..1000 (default 250)
+//   tactile_priority 0..98: the reader thread's SCHED_FIFO priority where permitted (default 1,
+//                   below every loop; 0: SCHED_OTHER)
 //   timeout_cycles  cycles without a fresh status before fault (default 2)
 //   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
 //   device_fault_cycles cycles in fault before it is reported as a device fault (default 50)
-// Threads: the tactile link's reader thread ("crease-tactile", on the non-RT CPUs) runs from
+// Threads: the tactile link's reader thread ("crease-tactile", on the non-RT CPUs, SCHED_FIFO
+// tactile_priority where permitted) runs from
 // activate to deactivate: it sends Start, deframes and decodes, and queues every sample.
 // Cycle phases: update reads the bus, takes the queued tactile samples and publishes
 // hand_state / tactile; write sends the newest
@@ -80,6 +83,7 @@ class HandDriver final : public Plugin {
       // Older than this, the taxels are a link fault (the default: 5 samples at 250 Hz).
       tc.max_age_ns = static_cast<std::int64_t>(
           1e6 * p.get_in_range<double>("tactile_max_age_ms", static_cast<double>(tc.max_age_ns) / 1e6, 1.0, 1000.0));
+      tc.thread_priority = p.get_in_range<int>("tactile_priority", tc.thread_priority, 0, 98);
       tactile_ = std::make_unique<dr::TactileReader>(std::make_unique<dr::FdSerialIo>(serial_->fd()), tc, "crease-tactile");
       tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
     }

@@ -23,6 +23,8 @@
 #include "core/port_types/sequence_status.h"
 #include "core/port_types/world_state.h"
 #include "rt/latest.h"
+#include "rt/thread_placement.h"
+#include "tests/config/sim_link_watch.h"
 
 using namespace crease;
 
@@ -78,6 +80,7 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
   auto status = reader<SequenceStatus>(host, "fold.status");
   auto world = reader<WorldState>(host, "world_state");
   host.start();
+  test::SimLinkWatch links(host);
 
   // creasectl sequence start: taken once its guard passes (every controller answering, the
   // contact states healthy, both hands commanded, the sheet seen by vision and the model).
@@ -86,6 +89,7 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (i % 50 == 0) host.poll();  // as creased does: the loops' events and logs
     status.poll();
+    links.poll();
   }
   REQUIRE(status.value().phase == SequenceStatus::running);
   REQUIRE(world.poll().has_data());
@@ -105,6 +109,7 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (i % 50 == 0) host.poll();
     status.poll();
+    links.poll();
     if (world.poll().is_new()) {
       const Tips t = tips(world.value());
       lowest_mm = std::min(lowest_mm, t.right_ff_z_mm);
@@ -119,6 +124,16 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
     if (deeper(path) && press_force_n > 0.5) break;
   }
   const auto own_reason = static_cast<int>(status.value().abort_reason);
+  std::string loops;
+  for (const Loop* l : host.loops())
+    loops += l->spec().name + ": " + std::to_string(l->timing().overruns.load()) + " overruns, " +
+             std::to_string(l->timing().late_wakes.load()) + " late wakes, wake-up latency up to " +
+             std::to_string(static_cast<double>(l->timing().wakeup_latency.max_ns()) / 1e6) + " ms, body up to " +
+             std::to_string(static_cast<double>(l->timing().execution.max_ns()) / 1e6) + " ms, " +
+             std::to_string(l->timing().missed_periods.load()) + " missed periods\n";
+  for (const rt::ThreadInfo& th : rt::list_threads())
+    loops += th.name + " " + th.policy + " " + std::to_string(th.priority) + " cpus " + rt::format_cpu_list(th.cpus) + "; ";
+  MESSAGE("the simulated link until here:\n" << links.summary() << loops);
   MESSAGE("deepest state " << deepest << ", the right index pad down to " << lowest_mm << " mm, pressing " << press_force_n
                            << " N; " << (status.value().phase == SequenceStatus::running
                                              ? std::string("running")
