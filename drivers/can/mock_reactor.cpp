@@ -96,6 +96,7 @@ void Reactor::attach(BrokerCore* core, int listen_fd) {
   waiters_.fetch_add(1);
   std::lock_guard lk(mu_);
   waiters_.fetch_sub(1);
+  waiters_.notify_all();
   cores_.push_back(core);
   watch_locked(core, listen_fd);
 }
@@ -105,6 +106,7 @@ void Reactor::detach(BrokerCore* core) {
   wake();
   std::lock_guard lk(mu_);
   waiters_.fetch_sub(1);
+  waiters_.notify_all();
   cores_.erase(std::remove(cores_.begin(), cores_.end(), core), cores_.end());
   for (const auto& [fd, c] : fds_) {
     if (c == core) ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
@@ -158,8 +160,11 @@ void Reactor::run() {
   std::unique_lock lk(mu_);
   while (!stop_.load(std::memory_order_acquire)) {
     if (waiters_.load(std::memory_order_acquire) > 0) {  // hand the lock to attach()/detach()
+      // Blocked, not spinning: at SCHED_FIFO a yield gives the CPU to no SCHED_OTHER waiter,
+      // so on a CPU the loops keep busy the waiter might never get the lock.
       lk.unlock();
-      while (waiters_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
+      for (int w = waiters_.load(std::memory_order_acquire); w > 0; w = waiters_.load(std::memory_order_acquire))
+        waiters_.wait(w, std::memory_order_acquire);
       lk.lock();
       continue;
     }

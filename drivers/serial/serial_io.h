@@ -23,8 +23,8 @@ class SerialIo {
   virtual void wake() noexcept = 0;
 };
 
-// A non-blocking tty fd the caller keeps open (and closes after this is gone); an eventfd
-// wakes the wait.
+// A non-blocking tty fd (or a Unix stream socket: unix_link.h; its writes never raise
+// SIGPIPE) the caller keeps open (and closes after this is gone); an eventfd wakes the wait.
 class FdSerialIo final : public SerialIo {
  public:
   // Throws std::runtime_error when no eventfd can be made.
@@ -38,6 +38,7 @@ class FdSerialIo final : public SerialIo {
 
  private:
   int fd_;
+  bool socket_ = false;
   int wake_fd_ = -1;
 };
 

@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <pty.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -76,16 +78,25 @@ void PtyPair::close_slave() noexcept {
   slave_ = -1;
 }
 
+SerialLink::SerialLink(int fd) noexcept : fd_(fd) {
+  struct stat st{};
+  socket_ = ::fstat(fd, &st) == 0 && S_ISSOCK(st.st_mode);
+}
+
+long SerialLink::put(const std::uint8_t* bytes, std::size_t n) noexcept {
+  return socket_ ? ::send(fd_, bytes, n, MSG_NOSIGNAL | MSG_DONTWAIT) : ::write(fd_, bytes, n);
+}
+
 bool SerialLink::send_from_rt(std::uint8_t type, std::span<const std::uint8_t> payload) noexcept {
   const std::size_t n = serial_encode(seq_, type, payload, tx_);
   if (n == 0) return false;
   ++seq_;
-  const ssize_t w = ::write(fd_, tx_, n);
-  if (w != static_cast<ssize_t>(n)) {
+  const long w = put(tx_, n);
+  if (w != static_cast<long>(n)) {
     ++tx_stats_.tx_short;
     if (w > 0) {
       const std::uint8_t zero = 0;  // terminate the partial frame so the peer drops it
-      (void)!::write(fd_, &zero, 1);
+      (void)put(&zero, 1);
     }
     return false;
   }

@@ -63,10 +63,11 @@ struct SerialLinkStats {
   std::uint64_t tx_short = 0;  // frames the tty did not fully accept (dropped, counted)
 };
 
-// Framed messages over any byte fd (a SerialPort or a pty master). RT-safe after construction.
+// Framed messages over any byte fd (a SerialPort, a pty master, a Unix stream socket:
+// unix_link.h; on a socket, writes never raise SIGPIPE). RT-safe after construction.
 class SerialLink {
  public:
-  explicit SerialLink(int fd) noexcept : fd_(fd) {}
+  explicit SerialLink(int fd) noexcept;
   // Sends one frame with the next sequence number. False if the tty took only part of it
   // (the receiver then discards the partial frame at the next delimiter).
   bool send_from_rt(std::uint8_t type, std::span<const std::uint8_t> payload) noexcept;
@@ -76,7 +77,9 @@ class SerialLink {
   [[nodiscard]] const SerialLinkStats& tx_stats() const noexcept { return tx_stats_; }
 
  private:
+  [[nodiscard]] long put(const std::uint8_t* bytes, std::size_t n) noexcept;
   int fd_;
+  bool socket_ = false;
   std::uint8_t seq_ = 0;
   SerialDeframer deframer_;
   std::uint8_t rx_[1024] = {};

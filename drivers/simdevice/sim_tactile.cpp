@@ -41,7 +41,17 @@ void SimTactile::step(std::int64_t now_ns) noexcept {
   }
   std::uint8_t payload[tactile::kSampleLen];
   const std::size_t n = tactile::encode_sample(s, payload);
-  if (link_.send_from_rt(tactile::kTypeSample, {payload, n})) ++sent_;
+  if (link_.send_from_rt(tactile::kTypeSample, {payload, n})) {
+    ++sent_;
+  } else {
+    ++dropped_;
+  }
+}
+
+void SimTactile::reset_link(int fd) noexcept {
+  link_ = SerialLink(fd);
+  rate_hz_ = 0;
+  rate_pub_.store(0);
 }
 
 }  // namespace crease::drivers::sim

@@ -20,7 +20,12 @@ class SimTactile {
   // external_pressures: what the next samples carry (kPa), from the thread that calls step().
   void set_pressures(const float (&kpa)[tactile::kFingertips][tactile::kTaxels]) noexcept;
   void set_silent(bool s) noexcept { silent_.store(s); }
+  // From the thread that calls step(): serve a new link (another connection of a socket
+  // link) from scratch, silent until its Start. RT-safe.
+  void reset_link(int fd) noexcept;
   [[nodiscard]] std::uint64_t samples_sent() const noexcept { return sent_.load(); }
+  // Samples the link did not take whole (its buffer full: the reader behind), dropped.
+  [[nodiscard]] std::uint64_t samples_dropped() const noexcept { return dropped_.load(); }
   [[nodiscard]] std::uint16_t rate_hz() const noexcept { return rate_pub_.load(); }
 
  private:
@@ -28,7 +33,7 @@ class SimTactile {
   std::uint16_t rate_hz_ = 0;
   std::uint16_t counter_ = 0;
   std::int64_t next_ns_ = 0, t0_ns_ = 0;
-  std::atomic<std::uint64_t> sent_{0};
+  std::atomic<std::uint64_t> sent_{0}, dropped_{0};
   std::atomic<std::uint16_t> rate_pub_{0};
   std::atomic<float> force_[tactile::kFingertips] = {};
   std::atomic<bool> silent_{false};

@@ -14,7 +14,8 @@
 //   pressure_sensors true for the left hand's air-pressure sensors (default false)
 //   tactile_device  serial device of the tactile matrix (default: none); a bare name (no '/')
 //                   with bus_prefix is the simulated robot's link of that name
-//                   (drivers/host/bus_prefix.h: simulated_link_path, made by sim_world)
+//                   (drivers/host/bus_prefix.h: simulated_link_path; sim_world serves it on a Unix
+//                   socket, drivers/serial/unix_link.h; sim_devices on a pty)
 //   tactile_rate_hz 1..1000 (default 250)
 //   tactile_priority 0..98: the reader thread's SCHED_FIFO priority where permitted (default 1,
 //                   below every loop; 0: SCHED_OTHER)
@@ -38,8 +39,11 @@
 // Status::degraded, and Status::device_fault once they lasted device_fault_cycles after the
 // sensor's first sample (or its 1000 first-contact cycles); the hand is not made safe for it
 // (its controllers see the tactile port's health), and the report recovers with the samples.
+#include <unistd.h>
+
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "core/plugin.h"
 #include "core/port_types/hand.h"
@@ -50,6 +54,7 @@
 #include "drivers/host/tactile_reader.h"
 #include "drivers/serial/serial_io.h"
 #include "drivers/serial/serial_port.h"
+#include "drivers/serial/unix_link.h"
 
 namespace {
 using namespace crease;
@@ -73,8 +78,17 @@ class HandDriver final : public Plugin {
         if (!dr::valid_link_name(dev)) p.fail("tactile_device", "a link name is 1..32 of [A-Za-z0-9._-]");
         dev = dr::simulated_link_path(*prefix, dev);
       }
+      int fd = -1;
       try {
-        serial_ = std::make_unique<dr::SerialPort>(dr::SerialConfig{dev, 1'000'000, false});
+        // A simulated robot's link is a Unix socket (sim_world) or a pty (sim_devices); a
+        // sensor is a tty.
+        if (dr::is_unix_socket(dev)) {
+          socket_ = UniqueFd(dr::connect_unix_link(dev));
+          fd = socket_.fd;
+        } else {
+          serial_ = std::make_unique<dr::SerialPort>(dr::SerialConfig{dev, 1'000'000, false});
+          fd = serial_->fd();
+        }
       } catch (const std::exception& e) {
         p.fail("tactile_device", e.what());
       }
@@ -84,7 +98,7 @@ class HandDriver final : public Plugin {
       tc.max_age_ns = static_cast<std::int64_t>(
           1e6 * p.get_in_range<double>("tactile_max_age_ms", static_cast<double>(tc.max_age_ns) / 1e6, 1.0, 1000.0));
       tc.thread_priority = p.get_in_range<int>("tactile_priority", tc.thread_priority, 0, 98);
-      tactile_ = std::make_unique<dr::TactileReader>(std::make_unique<dr::FdSerialIo>(serial_->fd()), tc, "crease-tactile");
+      tactile_ = std::make_unique<dr::TactileReader>(std::make_unique<dr::FdSerialIo>(fd), tc, "crease-tactile");
       tactile_out_ = ports.latest_output<Tactile>("tactile", Tactile{});
     }
     command_ = ports.latest_input<HandCommand>("hand_command");
@@ -173,8 +187,22 @@ class HandDriver final : public Plugin {
   std::uint64_t tactile_first_contact_cycles_ = 1000;
   Status status_ = Status::degraded;      // this cycle's verdict of both links (update's, again in write)
   std::unique_ptr<dr::HandHost> host_;
+  struct UniqueFd {
+    int fd = -1;
+    UniqueFd() = default;
+    explicit UniqueFd(int f) : fd(f) {}
+    UniqueFd(const UniqueFd&) = delete;
+    UniqueFd& operator=(UniqueFd&& o) noexcept {
+      std::swap(fd, o.fd);
+      return *this;
+    }
+    ~UniqueFd() {
+      if (fd >= 0) ::close(fd);
+    }
+  };
   std::unique_ptr<dr::SerialPort> serial_;
-  std::unique_ptr<dr::TactileReader> tactile_;  // after serial_: stopped before the port closes
+  UniqueFd socket_;                             // a simulated link's connection, or none
+  std::unique_ptr<dr::TactileReader> tactile_;  // after serial_, socket_: stopped before they close
   LatestInput<HandCommand> command_;
   LatestOutput<HandState> state_out_;
   LatestOutput<Tactile> tactile_out_;

@@ -1,12 +1,8 @@
 #include "plugins/sim_world/world_tactile.h"
 
-#include <filesystem>
-#include <stdexcept>
-#include <system_error>
+#include <unistd.h>
 
 namespace crease::world {
-
-namespace fs = std::filesystem;
 
 WorldTactile::WorldTactile(const robot::RobotParams& robot, std::uint64_t seed, const std::string& link_path) {
   for (int s = 0; s < 2; ++s) {
@@ -16,27 +12,14 @@ WorldTactile::WorldTactile(const robot::RobotParams& robot, std::uint64_t seed, 
     if (t.kind == robot::TactileKind::pst && pst_side_ < 0) pst_side_ = s;
   }
   if (link_path.empty() || taxel_side_ < 0) return;
-  pty_ = std::make_unique<drivers::PtyPair>();
-  std::error_code ec;
-  if (fs::is_symlink(fs::symlink_status(link_path, ec))) {
-    if (fs::exists(link_path, ec)) {
-      throw std::runtime_error("the tactile link " + link_path + " is taken (-> " + fs::read_symlink(link_path, ec).string() +
-                               ")");
-    }
-    fs::remove(link_path, ec);  // a dangling link a dead robot left
-  }
-  fs::create_symlink(pty_->slave_path(), link_path, ec);
-  if (ec) throw std::runtime_error("cannot create the tactile link " + link_path + ": " + ec.message());
+  listener_ = std::make_unique<drivers::UnixLinkListener>(link_path);
   link_path_ = link_path;
-  device_ = std::make_unique<drivers::sim::SimTactile>(pty_->master_fd(), true);
+  device_ = std::make_unique<drivers::sim::SimTactile>(-1, true);
 }
 
 WorldTactile::~WorldTactile() {
   device_.reset();
-  if (!link_path_.empty()) {
-    std::error_code ec;
-    fs::remove(link_path_, ec);
-  }
+  if (peer_ >= 0) ::close(peer_);
 }
 
 void WorldTactile::step_rt(const WorldState& state, double dt_s, drivers::sim::SimRobot& robot,
@@ -48,8 +31,23 @@ void WorldTactile::step_rt(const WorldState& state, double dt_s, drivers::sim::S
   if (taxel_side_ >= 0) {
     model_[taxel_side_]->taxels_rt(state.hand[taxel_side_], taxels_);
     if (device_) {
-      device_->set_pressures(taxels_);
-      device_->step(device_ns);
+      // The connection's peer gone (looked at every 8 steps): serve the next one waiting.
+      if (peer_ >= 0 && ++steps_ % 8 == 0 && drivers::unix_link_hung_up(peer_)) {
+        ::close(peer_);
+        peer_ = -1;
+      }
+      if (peer_ < 0) {
+        const int fd = listener_->accept_rt();
+        if (fd >= 0) {
+          peer_ = fd;
+          device_->reset_link(fd);
+          connections_.fetch_add(1, std::memory_order_relaxed);
+        }
+      }
+      if (peer_ >= 0) {
+        device_->set_pressures(taxels_);
+        device_->step(device_ns);
+      }
     }
   }
 }

@@ -4,7 +4,12 @@
 #include "drivers/host/tactile_reader.h"
 
 #include <doctest/doctest.h>
+#include <pthread.h>
+#include <sched.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -12,7 +17,9 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/serial/serial_port.h"
 #include "rt/alloc_guard.h"
+#include "rt/clock.h"
 
 using namespace crease::drivers;
 
@@ -239,4 +246,116 @@ TEST_CASE("tactile reader: stop wakes a blocked reader and joins it; start runs 
   REQUIRE(rig.link->drained());
   CHECK(take(*rig.reader));
   CHECK(rig.reader->sample().sample_counter == 3);
+}
+
+namespace {
+// The calling thread on one CPU (the process's last) at SCHED_FIFO PRIORITY (0: SCHED_OTHER);
+// undone at scope exit.
+struct PinnedThread {
+  cpu_set_t before{};
+  int cpu = -1;
+  bool fifo = false;
+  PinnedThread() {
+    (void)pthread_getaffinity_np(pthread_self(), sizeof before, &before);
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &before)) cpu = c;
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(cpu, &one);
+    REQUIRE(pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0);
+  }
+  bool raise(int priority) {
+    sched_param sp{};
+    sp.sched_priority = priority;
+    fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+    return fifo;
+  }
+  ~PinnedThread() {
+    sched_param sp{};
+    if (fifo) (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &sp);
+    (void)pthread_setaffinity_np(pthread_self(), sizeof before, &before);
+  }
+};
+}  // namespace
+
+// The simulated robot's trouble (config.sim_sequence: the taxels 100 ms old, a link fault)
+// made certain: on the reader's one CPU a real-time thread below the reader's priority spins
+// (the loops and the bus's thread of a loaded machine), and the sensor (FIFO 3, the world's
+// loop) sends 250 Hz samples over a socket (drivers/serial/unix_link.h) while the RT side
+// (the same thread, 1 kHz) takes them. At SCHED_FIFO 2 the reader preempts the hog and the link
+// stays healthy at the simulated robot's 100 ms tolerance in every cycle; at SCHED_OTHER
+// (thread_priority 0, the failing variant) it waits behind the hog and the link faults.
+TEST_CASE("tactile reader: at SCHED_FIFO it keeps the samples fresh while real-time work below it holds its CPU") {
+  int priority = 2;
+  SUBCASE("as shipped: the reader at SCHED_FIFO 2") {}
+  SUBCASE("failing variant: the reader at SCHED_OTHER starves behind the hog") { priority = 0; }
+  PinnedThread self;  // the reader (made next) inherits the one CPU, not a priority
+  int sv[2];
+  REQUIRE(::socketpair(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, sv) == 0);
+  TactileHostConfig cfg;
+  cfg.max_age_ns = 100'000'000;
+  cfg.thread_priority = priority;
+  TactileReader reader(std::make_unique<FdSerialIo>(sv[1]), cfg, "crease-t-tact");
+  reader.start();
+  for (int i = 0; i < 10000 && !reader.started(); ++i) std::this_thread::sleep_for(std::chrono::microseconds(100));
+  REQUIRE(reader.started());
+  if (!self.raise(3)) {
+    // No real-time scheduling here: no hog can starve anything, nor can the reader rise.
+    MESSAGE("SCHED_FIFO not permitted: the reader runs at the policy it inherited");
+    CHECK_FALSE(reader.fifo());
+    reader.stop();
+    ::close(sv[0]);
+    ::close(sv[1]);
+    return;
+  }
+  CHECK(reader.fifo() == (priority > 0));
+  std::atomic<bool> stop{false}, hogging{false};
+  std::thread hog([&] {  // inherits FIFO 3 and the CPU; spins at FIFO 1
+    sched_param sp{};
+    sp.sched_priority = 1;
+    if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) != 0) return;
+    hogging.store(true);
+    while (!stop.load(std::memory_order_relaxed)) {
+    }
+  });
+  while (!hogging.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  SerialLink sensor(sv[0]);
+  std::uint64_t sent = 0;
+  int fault_cycles = 0, cycles = 0;
+  timespec next{};
+  ::clock_gettime(CLOCK_MONOTONIC, &next);
+  for (int ms = 0; ms < 1200; ++ms) {
+    next.tv_nsec += 1'000'000;
+    if (next.tv_nsec >= 1'000'000'000) {
+      next.tv_nsec -= 1'000'000'000;
+      ++next.tv_sec;
+    }
+    ::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    const std::int64_t now = crease::rt::now_ns();
+    if (ms % 4 == 0) {
+      tactile::Sample s;
+      s.sample_counter = static_cast<std::uint16_t>(sent);
+      s.valid = 0x1F;
+      std::uint8_t payload[tactile::kSampleLen];
+      const std::size_t n = tactile::encode_sample(s, payload);
+      sent += sensor.send_from_rt(tactile::kTypeSample, {payload, n}) ? 1 : 0;
+    }
+    (void)reader.take_rt(now);
+    if (reader.samples() == 0) continue;  // from the first sample on
+    ++cycles;
+    if (reader.health(now) == LinkHealth::fault) ++fault_cycles;
+  }
+  stop.store(true);
+  hog.join();
+  reader.stop();
+  ::close(sv[0]);
+  ::close(sv[1]);
+  MESSAGE("priority " << priority << ": " << sent << " samples sent, " << reader.samples() << " taken, " << fault_cycles
+                      << " of " << cycles << " cycles with the link in fault");
+  if (priority > 0) {
+    CHECK(reader.samples() >= sent - 1);  // every one but perhaps the last in flight
+    CHECK(fault_cycles == 0);
+  } else {
+    CHECK(fault_cycles > 100);  // the taxels over 100 ms old for over 100 ms
+  }
 }
