@@ -39,9 +39,10 @@ inline constexpr std::size_t kMaxBusPrefix = 64;  // leaves room for the bus in 
 // "<prefix>-<bus>".
 [[nodiscard]] std::string prefixed_bus(const std::string& prefix, std::string_view bus);
 
-// Where a simulated robot's serial link (a pty's slave, e.g. the right hand's tactile matrix)
-// is found: "<dir>/<prefix>-<name>", dir $XDG_RUNTIME_DIR or else /tmp; the simulated device
-// puts a symlink to the pty there, the driver opens it. NAME: 1..32 of [A-Za-z0-9._-].
+// Where a simulated robot's serial link (e.g. the right hand's tactile matrix) is found:
+// "<dir>/<prefix>-<name>", dir $XDG_RUNTIME_DIR or else /tmp; the simulated device listens on a
+// Unix socket there (sim_world) or puts a symlink to a pty's slave (sim_devices), the driver
+// connects or opens it. NAME: 1..32 of [A-Za-z0-9._-].
 [[nodiscard]] std::string simulated_link_path(const std::string& prefix, std::string_view name);
 [[nodiscard]] bool valid_link_name(std::string_view name) noexcept;
 

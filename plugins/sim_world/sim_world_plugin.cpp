@@ -8,7 +8,7 @@
 //   output world_state  (latest WorldState: fingertips, contact forces, joint angles, counters)
 //   output sheet_truth  (latest SheetState: the world's sheet, every truth_every_steps steps)
 // The fingertips' forces reach the drivers as tactile readings (world_tactile.h): the right
-// hand's taxel matrix on a pty link (hand_driver `tactile_device: tactile_r`), the left hand's
+// hand's taxel matrix on a socket link (hand_driver `tactile_device: tactile_r`), the left hand's
 // PST sensors in its pressure frames.
 // The devices answer on `<bus_prefix>-hand_r`, `-hand_l`, `-arm_r`, `-arm_l` as sim_devices'
 // do (this plugin takes its place; the drivers' parameters are the same). Parameters:

@@ -21,7 +21,7 @@ struct WorldPluginConfig {
   int truth_stride = 1;
   std::string bus_prefix;  // resolved (`auto`: this creased's own, drivers/host/bus_prefix.h)
   std::uint32_t bitrate = 1'000'000, data_bitrate = 5'000'000;
-  // `tactile_link`: the taxel matrix's serial link, a pty at simulated_link_path(bus_prefix,
+  // `tactile_link`: the taxel matrix's serial link, a Unix socket at simulated_link_path(bus_prefix,
   // this) (drivers/host/bus_prefix.h) for hand_driver's `tactile_device: tactile_r`; empty
   // (`none`): no link.
   std::string tactile_link = "tactile_r";

@@ -137,10 +137,9 @@ TEST_CASE("config/sim.yaml's controllers, idle: the hands held stiff where they 
   host.stop();
 
   REQUIRE(world_seen);
-  // Samples the sensor sent that never arrived: on this machine the pty's kernel side (its
-  // flush work runs as SCHED_OTHER beside two pinned RT loops and other builds) sometimes falls
-  // behind, the pty's ~12 kB fill up and the world's sensor drops samples (a partial one is a
-  // CRC error here). A figure, not asserted: the driver's own test shows none lost.
+  // Samples the sensor sent that never arrived: the socket link's buffer full (its reader
+  // behind) drops them at the world's sensor (a partial one is a CRC error here). A figure, not
+  // asserted: the driver's own test shows none lost.
   const auto span = static_cast<std::uint16_t>(tactile.value().sample_counter - first_tactile.sample_counter);
   MESSAGE("the world's hand joints moved at most " << world_moved_rad << " rad; taxel samples " << tactile.value().frames
                                                   << ", lost on the link " << span - (tactile.value().frames - first_tactile.frames)
