@@ -7,6 +7,8 @@
 // the hands open and pressing nothing and the arms clear, lifted from where they were. Scored
 // from the world's truth (world_state: fingertip poses and forces, the hands' joint angles).
 // Every transition is on the run's timeline. Failing variant: the arm goals reach no arm.
+// It prints the simulated link as it saw it (sim_link_watch.h: each device port's oldest age
+// and first fault, the world's lag) and the loops' timing, so a device_fault names its port.
 #include <doctest/doctest.h>
 
 #include <algorithm>
