@@ -1,7 +1,7 @@
 // The copies between port payloads and their IDL's C structs (hand_mirror.h,
-// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h, sheet_edit_mirror.h): a round trip keeps every field; the checks
-// on the way in refuse non-finite and out-of-range values, inconsistent lengths and more
-// entries than the payload holds.
+// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h, sheet_edit_mirror.h): a round trip keeps
+// every field; the checks on the way in refuse non-finite and out-of-range values, inconsistent
+// lengths and more entries than the payload holds.
 #include <doctest/doctest.h>
 
 #include <cmath>
