@@ -1,8 +1,9 @@
 // dds_bridge's queue ports (queue_links.h) between two hosts of one process: the sheet model's
 // edits (sheet_crease, sheet_memorize) pushed on one host arrive on the other's queue ports once
 // each, in order, and nothing more on later cycles; an unbridged queue port's events arrive
-// nowhere (the failing variant); a queue topic is stale only while no publisher is alive; bad
-// events from a raw Cyclone writer are counted and dropped; the RT part allocates nothing.
+// nowhere (the failing variant); a queue topic is stale only while no publisher is alive; a full
+// port drops and counts what does not fit, the loop unblocked; bad events from a raw Cyclone
+// writer are counted and dropped; the RT part allocates nothing.
 // The test thread is the one producer of the publishing host's queue ports and the one consumer
 // of the subscribing host's (no plugin binds the other end).
 #include <dds/dds.h>
@@ -202,6 +203,39 @@ TEST_CASE("failing variant: a queue port the publishing bridge does not bridge d
   CHECK(b.stats("bridge").topics[0].samples == 0);
   CHECK(b.stats("bridge").topics[0].stale == 1);  // no publisher of it at all
   CHECK(crease_in->size_approx() == kN);          // never taken
+  b.host.stop();
+  a.host.stop();
+}
+
+TEST_CASE("a reader that falls behind: the full port drops the newest events and counts them, the loop runs on") {
+  BridgeHost b;
+  add_subscriber(b, "full");
+  b.host.start();
+  BridgeHost a;
+  add_publisher(a, "full");
+  a.host.start();
+  REQUIRE(eventually([&] { return matched(a, b, 2); }));
+  rt::QueueChannel& in = queue(a, "sheet_crease");
+  rt::QueueChannel& out = queue(b, "sheet_crease");
+  const std::size_t capacity = out.capacity();
+  // Nobody pops b's port: its first `capacity` events stay, the 44 after them are dropped.
+  int next = 0;
+  for (const std::size_t burst : {capacity - 56, std::size_t{100}}) {
+    for (std::size_t i = 0; i < burst; ++i, ++next) {
+      const SheetCreaseEvent e = crease_event(next);
+      REQUIRE(in.try_push(&e));
+    }
+    REQUIRE(eventually([&] { return b.stats("bridge").topics[0].samples == static_cast<std::uint64_t>(next); }));
+  }
+  REQUIRE(eventually([&] { return b.stats("bridge").topics[0].queue_full == 44; }));
+  const std::uint64_t cycles = b.updates("bridge");
+  REQUIRE(eventually([&] { return b.updates("bridge") > cycles + 100; }));  // not blocked
+  CHECK(b.stats("bridge").topics[0].port_writes == capacity);
+  CHECK(b.stats("bridge").topics[0].queue_full == 44);
+  const std::vector<SheetCreaseEvent> got = drain<SheetCreaseEvent>(out);
+  REQUIRE(got.size() == capacity);
+  CHECK(got.front().id == 0);
+  CHECK(got.back().id == static_cast<std::int32_t>(capacity) - 1);
   b.host.stop();
   a.host.stop();
 }
