@@ -1,4 +1,4 @@
-// dds_bridge: carries local latest ports to other daemons and back over Eclipse Cyclone DDS.
+// dds_bridge: carries local latest and queue ports to other daemons and back over Eclipse Cyclone DDS.
 //
 // Parameters (README.md beside this file has the whole story):
 //   dds_config: FILE   CycloneDDS XML: domain, interfaces, peers (relative to the configuration
@@ -8,16 +8,18 @@
 //                      (default 0: SCHED_OTHER; Cyclone's own threads take theirs from the XML)
 //   publish:   [{port: P, topic: T, type: K, <QoS>}]   each new value of port P -> DDS topic rt/T
 //   subscribe: [{topic: T, port: P, type: K, <QoS>}]   samples of rt/T -> port P (this bridge writes it)
-//   type: keypoints | hand_state | hand_command | arm_state | arm_command | sheet_state
-//                      (optional when port P is already bound: its type)
+//   type: keypoints | hand_state | hand_command | arm_state | arm_command | sheet_state (latest
+//                      ports) | sheet_crease | sheet_memorize (queue ports: every event once, in
+//                      order; queue_links.h) (optional when port P is already bound: its type)
 //   view: joint_state  publish entries of hand_state and arm_state ports: as sensor_msgs/msg/JointState,
 //   joint_prefix: r_   its joints named prefix + the URDF's names (joint_state_view.h)
 //   QoS keys: reliability, depth, deadline_ms, liveliness_ms (topic_qos.h)
 // Ports: the configured ones, and `<instance>_stats` (crease::BridgeStats), its counters.
-// Status: degraded while a subscribed topic is stale (never heard, its publisher lost or late).
+// Status: degraded while a subscribed topic is stale (never heard, its publisher lost or late; a
+// queue topic: while no publisher of it is alive).
 // RT: update copies subscribed samples from the links' channels into their ports; the write
-// phase copies new values of published ports into the links' channels and wakes the publisher
-// thread. Every DDS call runs on the bridge's thread or Cyclone's (bridge_threads.h), never a loop's.
+// phase copies new values (a queue port: every event) of published ports into the links'
+// channels and wakes the publisher thread. Every DDS call runs on the bridge's thread or Cyclone's (bridge_threads.h), never a loop's.
 #include <algorithm>
 #include <memory>
 #include <set>
@@ -158,8 +160,8 @@ class DdsBridge final : public crease::Plugin {
     const std::string port = e.get<std::string>("port");
     const std::string topic = dds_topic_name(e, crease::BridgeTopicStats::kTopicCapacity - 1);
     if (!topics.insert(topic).second) e.fail("topic", "bridged twice by this instance: " + topic);
-    const TopicQos qos = parse_qos(e);
     const PayloadKind& kind = kind_of(e, ports, port);
+    const TopicQos qos = parse_qos(e, kind.queue);
     // `view: joint_state` (publish only): the port as sensor_msgs/msg/JointState.
     const std::string view = e.get<std::string>("view", "");
     if (e.has("view")) {

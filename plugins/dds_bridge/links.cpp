@@ -34,6 +34,7 @@ void Link::stats_rt(BridgeTopicStats& out) const noexcept {
   const auto get = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
   const LinkCounters& c = counters_;
   out.direction = direction_;
+  out.queue = c.events ? 1 : 0;
   out.stale = direction_ == BridgeTopicStats::subscribe && c.stale.load(std::memory_order_acquire) ? 1 : 0;
   out.matched = static_cast<std::uint16_t>(std::min<std::uint32_t>(c.matched.load(std::memory_order_relaxed), 0xffff));
   out.samples = get(c.samples);
@@ -47,6 +48,7 @@ void Link::stats_rt(BridgeTopicStats& out) const noexcept {
   out.deadline_missed = get(c.deadline_missed);
   out.liveliness_lost = get(c.liveliness_lost);
   out.incompatible_qos = get(c.incompatible_qos);
+  out.queue_full = get(c.queue_full);
 }
 
 namespace {
@@ -57,7 +59,11 @@ void add(std::atomic<std::uint64_t>& a, std::int64_t n) {
 
 void on_status(LinkCounters& c, const dds_liveliness_changed_status_t& s) {
   add(c.liveliness_lost, -static_cast<std::int64_t>(s.alive_count_change));
-  if (s.alive_count == 0) c.stale.store(true, std::memory_order_release);
+  if (s.alive_count == 0) {
+    c.stale.store(true, std::memory_order_release);
+  } else if (c.events) {
+    c.stale.store(false, std::memory_order_release);  // a queue topic: a live publisher is all it needs
+  }
 }
 void on_status(LinkCounters& c, const dds_requested_deadline_missed_status_t& s) {
   add(c.deadline_missed, s.total_count_change);
@@ -93,6 +99,22 @@ void take_writer_statuses(dds_entity_t writer, LinkCounters& c) {
   dds_offered_incompatible_qos_status_t q;
   if (dds_get_offered_incompatible_qos_status(writer, &q) == 0 && q.total_count_change > 0)
     c.incompatible_qos.fetch_add(static_cast<std::uint64_t>(q.total_count_change), std::memory_order_relaxed);
+}
+
+void listen_to_writer(dds_entity_t writer, LinkCounters& c) {
+  dds_listener_t* l = dds_create_listener(&c);
+  dds_lset_publication_matched(l, [](dds_entity_t, const dds_publication_matched_status_t s, void* arg) {
+    static_cast<LinkCounters*>(arg)->matched.store(s.current_count, std::memory_order_relaxed);
+  });
+  dds_lset_offered_incompatible_qos(l, [](dds_entity_t, const dds_offered_incompatible_qos_status_t s, void* arg) {
+    if (s.total_count_change > 0)
+      static_cast<LinkCounters*>(arg)->incompatible_qos.fetch_add(static_cast<std::uint64_t>(s.total_count_change),
+                                                                  std::memory_order_relaxed);
+  });
+  const dds_return_t rc = dds_set_listener(writer, l);
+  dds_delete_listener(l);
+  if (rc < 0) throw crease::Error(std::string("cannot listen to a writer: ") + dds_strretcode(rc));
+  take_writer_statuses(writer, c);  // what came before the listener was set
 }
 
 }  // namespace crease::dds_bridge

@@ -1,6 +1,7 @@
 // The links of a bridge: one per configured entry, between a local latest port and a DDS
 // endpoint, typed by the port payload T (keypoints_mirror.h, hand_mirror.h, arm_mirror.h,
-// sheet_mirror.h give Dds<T>; joint_state_view.h a publish-only view).
+// sheet_mirror.h give Dds<T>; joint_state_view.h a publish-only view). Queue ports (events)
+// have their own links on the same bases (queue_links.h).
 //
 // Each link owns a lock-free rt::LatestChannel between the RT side and its non-RT side:
 //   publish:   RT write phase: port -> channel (take_rt); publisher thread: channel -> dds_write
@@ -30,9 +31,11 @@ namespace crease::dds_bridge {
 // Counted by the non-RT side (relaxed: plain totals), read by the RT side.
 struct LinkCounters {
   std::atomic<std::uint64_t> samples{0}, lost{0}, rejected{0}, malformed{0}, oversized{0}, undecodable{0},
-      deadline_missed{0}, liveliness_lost{0}, incompatible_qos{0}, overwritten{0};
+      deadline_missed{0}, liveliness_lost{0}, incompatible_qos{0}, overwritten{0}, queue_full{0};
   std::atomic<std::uint32_t> matched{0};
   std::atomic<bool> stale{true};  // subscribe only: no fresh data (never heard, lost or late)
+  // A queue topic (set before any thread sees the link): stale only while no publisher is alive.
+  bool events = false;
 };
 
 // The DDS topic and endpoint of a link (non-RT; deleted with the link).
@@ -52,7 +55,10 @@ class Endpoint {
 
 class Link {
  public:
-  Link(std::string topic, BridgeTopicStats::Direction direction) : topic_(std::move(topic)), direction_(direction) {}
+  Link(std::string topic, BridgeTopicStats::Direction direction, bool queue = false)
+      : topic_(std::move(topic)), direction_(direction) {
+    counters_.events = queue;
+  }
   virtual ~Link() = default;
   Link(const Link&) = delete;
   Link& operator=(const Link&) = delete;
@@ -74,8 +80,8 @@ class Link {
 
 class PublishLink : public Link {
  public:
-  PublishLink(std::string topic) : Link(std::move(topic), BridgeTopicStats::publish) {}
-  // RT (write phase): a new port value into the channel; true when there was one.
+  explicit PublishLink(std::string topic, bool queue = false) : Link(std::move(topic), BridgeTopicStats::publish, queue) {}
+  // RT (write phase): a new port value (a queue: every event) into the channel; true when there was one.
   virtual bool take_rt() noexcept = 0;
   // Publisher thread: the channel's value to DDS when it is new to this side.
   virtual void publish() = 0;
@@ -83,12 +89,14 @@ class PublishLink : public Link {
 
 class SubscribeLink : public Link {
  public:
-  SubscribeLink(std::string topic) : Link(std::move(topic), BridgeTopicStats::subscribe) {}
+  explicit SubscribeLink(std::string topic, bool queue = false)
+      : Link(std::move(topic), BridgeTopicStats::subscribe, queue) {}
   // The reader's data listener (a Cyclone thread): takes the samples. One call at a time (a
   // lock: several Cyclone threads may call). The status listeners call on_status (links.cpp).
   virtual void receive() = 0;
   [[nodiscard]] virtual dds_entity_t reader() const noexcept = 0;
-  // RT (update): the newest sample into the port unless stale; true when the port is fresh.
+  // RT (update): the newest sample into the port unless stale (a queue: every event that came);
+  // true when the port is fresh.
   virtual bool give_rt() noexcept = 0;
 };
 
@@ -104,6 +112,9 @@ void on_status(LinkCounters& c, const dds_subscription_matched_status_t& s);
 void catch_up_statuses(dds_entity_t reader, LinkCounters& c);
 // Publisher thread: the writer's matched and incompatible-QoS statuses into `c`.
 void take_writer_statuses(dds_entity_t writer, LinkCounters& c);
+// The same kept current by listeners on `writer` (Cyclone's threads), for a link that writes
+// rarely (queue topics); `c` must outlive the writer. Throws crease::Error when refused.
+void listen_to_writer(dds_entity_t writer, LinkCounters& c);
 
 template <class T, class D>
 class PublishLinkT final : public PublishLink {

@@ -6,6 +6,8 @@
 #include "hand_mirror.h"
 #include "joint_state_view.h"
 #include "keypoints_mirror.h"
+#include "queue_links.h"
+#include "sheet_edit_mirror.h"
 #include "sheet_mirror.h"
 
 namespace crease::dds_bridge {
@@ -15,8 +17,21 @@ namespace {
 template <class T>
 PayloadKind kind_of() {
   using D = Dds<T>;
+  if constexpr (requires { D::kQueue; }) {
+    return PayloadKind{
+        D::kKey, port_type_of<T>(), true, D::descriptor()->m_typename,
+        [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
+           const TopicQos& qos) -> std::unique_ptr<PublishLink> {
+          return std::make_unique<QueuePublishLinkT<T, D>>(ports, port, pp, topic, qos);
+        },
+        [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
+           const TopicQos& qos) -> std::unique_ptr<SubscribeLink> {
+          return std::make_unique<QueueSubscribeLinkT<T, D>>(ports, port, pp, topic, qos);
+        },
+        nullptr};
+  }
   PayloadKind k{
-      D::kKey, port_type_of<T>(), D::descriptor()->m_typename,
+      D::kKey, port_type_of<T>(), false, D::descriptor()->m_typename,
       [](PortBinder& ports, const std::string& port, dds_entity_t pp, const std::string& topic,
          const TopicQos& qos) -> std::unique_ptr<PublishLink> {
         return std::make_unique<PublishLinkT<T, D>>(ports, port, pp, topic, qos);
@@ -39,7 +54,8 @@ PayloadKind kind_of() {
 
 const PayloadKind kKinds[] = {kind_of<crease::Keypoints>(), kind_of<crease::HandState>(),
                               kind_of<crease::HandCommand>(), kind_of<crease::ArmState>(),
-                              kind_of<crease::ArmCommand>(), kind_of<crease::SheetState>()};
+                              kind_of<crease::ArmCommand>(), kind_of<crease::SheetState>(),
+                              kind_of<crease::SheetCreaseEvent>(), kind_of<crease::SheetMemorizeEvent>()};
 
 }  // namespace
 

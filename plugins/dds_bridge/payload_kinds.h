@@ -8,6 +8,9 @@
 //   arm_state     crease::ArmState      crease_msgs::msg::dds_::ArmState_    (crease_msgs/msg/ArmState)
 //   arm_command   crease::ArmCommand    crease_msgs::msg::dds_::ArmCommand_  (crease_msgs/msg/ArmCommand)
 //   sheet_state   crease::SheetState    crease_msgs::msg::dds_::SheetState_  (crease_msgs/msg/SheetState)
+// and two of queue ports (events, each delivered once, in order: queue_links.h):
+//   sheet_crease   crease::SheetCreaseEvent   crease_msgs::msg::dds_::SheetCreaseEvent_
+//   sheet_memorize crease::SheetMemorizeEvent crease_msgs::msg::dds_::SheetMemorizeEvent_
 // hand_state and arm_state also publish as sensor_msgs/msg/JointState (`view: joint_state`,
 // joint_state_view.h).
 #pragma once
@@ -24,6 +27,7 @@ namespace crease::dds_bridge {
 struct PayloadKind {
   const char* key;       // the entry's `type:`
   PortType port_type;    // of the local port
+  bool queue;            // a queue port (events) rather than a latest port
   const char* dds_type;  // the topic's type name on the wire
   std::unique_ptr<PublishLink> (*make_publish)(PortBinder& ports, const std::string& port, dds_entity_t participant,
                                                const std::string& topic, const TopicQos& qos);

@@ -27,7 +27,7 @@ std::string dds_topic_name(const Params& entry, std::size_t max_length) {
   return dds;
 }
 
-TopicQos parse_qos(const Params& entry) {
+TopicQos parse_qos(const Params& entry, bool events) {
   TopicQos q;
   const std::string rel = entry.get<std::string>("reliability", "reliable");
   if (rel == "reliable") {
@@ -37,6 +37,11 @@ TopicQos parse_qos(const Params& entry) {
   } else {
     entry.fail("reliability", "expected reliable or best_effort, got '" + rel + "'");
   }
+  if (events && !q.reliable)
+    entry.fail("reliability", "a queue topic is reliable (each event delivered once, none lost while the peer is up)");
+  if (events && entry.has("deadline_ms"))
+    entry.fail("deadline_ms", "a queue topic has no deadline (its events come when they come)");
+  q.keep_all = events && !entry.has("depth");
   q.depth = entry.get_in_range<int>("depth", 1, 1, 1000);
   q.deadline_ns = static_cast<std::int64_t>(entry.get_in_range<double>("deadline_ms", 0.0, 0.0, 3.6e6) * 1e6);
   q.liveliness_ns = static_cast<std::int64_t>(entry.get_in_range<double>("liveliness_ms", 1000.0, 0.0, 3.6e6) * 1e6);
@@ -45,7 +50,11 @@ TopicQos parse_qos(const Params& entry) {
 
 QosPtr make_qos(const TopicQos& q) {
   QosPtr qos(dds_create_qos());
-  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, q.depth);
+  if (q.keep_all) {
+    dds_qset_history(qos.get(), DDS_HISTORY_KEEP_ALL, 0);
+  } else {
+    dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, q.depth);
+  }
   dds_qset_reliability(qos.get(), q.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
                        DDS_MSECS(100));
   dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);

@@ -90,6 +90,41 @@ TEST_CASE("config/split/control.yaml and config/split/vision.yaml validate: the 
   for (const char* n : {"cameras", "vision", "sheet"}) CHECK(vision.find_plugin(n) != nullptr);
 }
 
+TEST_CASE("config/split: the folding sequence's edits cross from the control daemon to the vision daemon's model") {
+  const auto control = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/split/control.yaml");
+  const auto vision = crease::config::load_daemon_config(CREASE_SOURCE_DIR "/config/split/vision.yaml");
+  const auto* fold = control.find_plugin("fold");
+  const auto* sheet = vision.find_plugin("sheet");
+  const auto* out = control.find_plugin("bridge");
+  const auto* in = vision.find_plugin("bridge");
+  REQUIRE(fold != nullptr);
+  REQUIRE(sheet != nullptr);
+  REQUIRE(out != nullptr);
+  REQUIRE(in != nullptr);
+  // The topic of the bridge entry (publish or subscribe list) that carries global port `port`.
+  const auto topic_of = [](const crease::config::PluginConfig& bridge, const char* list, const std::string& port) {
+    for (const auto& e : bridge.params[list])
+      if (e["port"].as<std::string>() == port) return e["topic"].as<std::string>();
+    return std::string();
+  };
+  const auto global = [](const crease::config::PluginConfig& p, const std::string& local) {
+    const auto it = p.ports.find(local);
+    return it == p.ports.end() ? local : it->second;
+  };
+  for (const auto& [fold_port, model_port] : {std::pair<std::string, std::string>{"sheet_crease", "crease"},
+                                              std::pair<std::string, std::string>{"sheet_memorize", "memorize"}}) {
+    CAPTURE(fold_port);
+    const std::string written = global(*fold, fold_port);   // the fold's queue in control
+    const std::string read = global(*sheet, model_port);     // the model's queue in vision
+    const std::string topic = topic_of(*out, "publish", written);
+    CHECK_FALSE(topic.empty());
+    CHECK(topic_of(*in, "subscribe", read) == topic);
+  }
+  // The vision bridge pushes the edits before the model's update in the same loop.
+  CHECK(in->loop == sheet->loop);
+  CHECK(in->order < sheet->order);
+}
+
 TEST_CASE("config/robot.yaml validates (its plugins need the hardware to configure)") {
   crease::config::LoadOptions o;
   o.check_plugin_dirs_exist = false;

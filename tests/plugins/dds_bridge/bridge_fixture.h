@@ -50,6 +50,11 @@ struct BridgeHost {
       if (i.name == name) return i.stats->degraded.load();
     return 0;
   }
+  std::uint64_t updates(const std::string& name) const {
+    for (const auto& i : host.instances())
+      if (i.name == name) return i.stats->updates.load();
+    return 0;
+  }
   RunState state(const std::string& name) const {
     for (const auto& i : host.instances())
       if (i.name == name) return i.state;

@@ -45,7 +45,7 @@ TEST_CASE("entries: unknown type or port, a type mismatch, a port with another w
   h.add("source", "crease_test_payload_source", 0, "{}");  // writes hand_state (crease.HandState)
   CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: p, type: hand_stat}]}"), "subscribe[0].type",
               "unknown type 'hand_stat' (the bridge carries keypoints, hand_state, hand_command, arm_state, "
-              "arm_command, sheet_state)"));
+              "arm_command, sheet_state, sheet_crease, sheet_memorize)"));
   CHECK(names(error_of(h, d() + "publish: [{port: nothing, topic: a}]}"), "publish[0].port",
               "unknown port 'nothing': no plugin configured before this bridge binds it"));
   CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, type: keypoints}]}"), "publish[0].type",
@@ -79,6 +79,16 @@ TEST_CASE("entries: unknown type or port, a type mismatch, a port with another w
               "publish[0].view", "a keypoints port has no joints (joint_state views: hand_state, arm_state)"));
   CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, joint_prefix: r_}]}"),
               "publish[0].joint_prefix", "only with view: joint_state"));
+  // Queue topics (events): reliable, no deadline; a queue port is not a latest port.
+  CHECK(names(error_of(h, d() + "publish: [{port: e, topic: a, type: sheet_crease, reliability: best_effort}]}"),
+              "publish[0].reliability", "a queue topic is reliable"));
+  CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: e, type: sheet_memorize, deadline_ms: 50}]}"),
+              "subscribe[0].deadline_ms", "a queue topic has no deadline"));
+  CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, type: sheet_crease}]}"), "publish[0].type",
+              "type mismatch: port 'hand_state' carries crease.HandState v1, not sheet_crease "
+              "(crease.SheetCreaseEvent v1)"));
+  CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: e, type: sheet_crease, view: joint_state}]}"),
+              "subscribe[0].view", "a view is published only"));
   // No domain: the XML's (dds/loopback.xml says any: domain 0), as config/split/ runs.
   CHECK(error_of(h, "{publish: [{port: hand_state, topic: " + crease::test::test_topic("no_domain") + "}]}") ==
         "no error");

@@ -1,7 +1,7 @@
 // The copies between port payloads and their IDL's C structs (hand_mirror.h,
-// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h): a round trip keeps every field; the checks
-// on the way in refuse non-finite and out-of-range values, inconsistent lengths and more
-// entries than the payload holds.
+// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h, sheet_edit_mirror.h): a round trip keeps
+// every field; the checks on the way in refuse non-finite and out-of-range values, inconsistent
+// lengths and more entries than the payload holds.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -11,6 +11,7 @@
 #include "arm_mirror.h"
 #include "hand_mirror.h"
 #include "keypoints_mirror.h"
+#include "sheet_edit_mirror.h"
 #include "sheet_mirror.h"
 
 using namespace crease;
@@ -209,4 +210,56 @@ TEST_CASE("sheet_state: only the valid nodes, creases and links travel; inconsis
   c->nodes_u = 65;
   c->nodes_v = 64;  // 4160 nodes: more than kMaxNodes
   CHECK(Dds<SheetState>::from_dds(*c, *back) == SampleCheck::oversized);
+}
+
+TEST_CASE("sheet_crease and sheet_memorize: a round trip keeps every field; bad events are refused") {
+  SheetCreaseEvent e;
+  e.timestamp_ns = 77;
+  e.op = SheetCreaseEvent::Op::remove;
+  e.id = 31;
+  e.a_mm[1] = -4.5f;
+  e.b_mm[0] = 210.0f;
+  Dds<SheetCreaseEvent>::C c{};
+  Dds<SheetCreaseEvent>::Scratch scratch;
+  Dds<SheetCreaseEvent>::to_dds(e, c, scratch);
+  SheetCreaseEvent back;
+  REQUIRE(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::ok);
+#define SAME_FIELD(f) CHECK(std::memcmp(&back.f, &e.f, sizeof(e.f)) == 0);
+  CREASE_SHEET_CREASE_EVENT_FIELDS(SAME_FIELD, SAME_FIELD)
+#undef SAME_FIELD
+  c.id = 32;  // ids are 0..31
+  CHECK(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::malformed);
+  c.id = -1;
+  CHECK(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::malformed);
+  c.op = 0;  // an add names no id
+  CHECK(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::ok);
+  c.op = 3;
+  CHECK(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::malformed);
+  c.op = 0;
+  c.a_mm[0] = std::nanf("");
+  CHECK(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::malformed);
+  c.a_mm[0] = 0;
+  c.b_mm[1] = -INFINITY;
+  CHECK(Dds<SheetCreaseEvent>::from_dds(c, back) == SampleCheck::malformed);
+
+  SheetMemorizeEvent m;
+  m.timestamp_ns = -3;
+  m.whole_sheet = false;
+  m.min_mm[0] = 1.0f;
+  m.max_mm[1] = 297.0f;
+  Dds<SheetMemorizeEvent>::C mc{};
+  Dds<SheetMemorizeEvent>::Scratch ms;
+  Dds<SheetMemorizeEvent>::to_dds(m, mc, ms);
+  SheetMemorizeEvent mback;
+  mback.whole_sheet = true;
+  REQUIRE(Dds<SheetMemorizeEvent>::from_dds(mc, mback) == SampleCheck::ok);
+#define SAME_FIELD(f) CHECK(std::memcmp(&mback.f, &m.f, sizeof(m.f)) == 0);
+  CREASE_SHEET_MEMORIZE_EVENT_FIELDS(SAME_FIELD, SAME_FIELD)
+#undef SAME_FIELD
+  const std::uint8_t two = 2;  // a byte that is no bool
+  std::memcpy(&mc.whole_sheet, &two, 1);
+  CHECK(Dds<SheetMemorizeEvent>::from_dds(mc, mback) == SampleCheck::malformed);
+  mc.whole_sheet = true;
+  mc.max_mm[0] = INFINITY;
+  CHECK(Dds<SheetMemorizeEvent>::from_dds(mc, mback) == SampleCheck::malformed);
 }
