@@ -214,10 +214,12 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
   // Damage: the grid's edges against their rest lengths; below the table.
   const double du = W > 1 ? s.width_mm / (W - 1) : 1.0, dv = H > 1 ? s.height_mm / (H - 1) : 1.0;
   double zmin = 1e9;
+  int below = 0;
   for (int j = 0; j < H; ++j)
     for (int i = 0; i < W; ++i) {
       const float* x = pos(i, j);
       zmin = std::min(zmin, double(x[2]));
+      below += x[2] < -kBelowTableMm;
       auto stretch = [&](const float* y, double rest) {
         const double d = std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]));
         r.max_stretch = std::max(r.max_stretch, (d - rest) / rest);
@@ -226,7 +228,7 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
       if (j + 1 < H) stretch(pos(i, j + 1), dv);
     }
   r.torn = r.max_stretch > kTornStretch;
-  r.off_table = zmin < -kBelowTableMm;
+  r.off_table = below >= kOffTableFraction * W * H;
 
   // The base's slip from the reference.
   BaseFit ref;
@@ -247,7 +249,7 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
   if (r.torn) {
     std::snprintf(buf, sizeof buf, "torn (an edge stretched %.1f %%)", 100 * r.max_stretch);
   } else if (r.off_table) {
-    std::snprintf(buf, sizeof buf, "off the table (%.1f mm below its top)", -zmin);
+    std::snprintf(buf, sizeof buf, "off the table (%d of %d nodes below its top, down to %.1f mm)", below, W * H, -zmin);
   } else if (!std::isfinite(r.fold_line_mm)) {
     std::snprintf(buf, sizeof buf, "no fold (%d of %d flap nodes folded onto the base)", r.folded_nodes, r.flap_nodes);
   } else if (r.fold_line_mm > b.fold_line_mm) {

@@ -17,7 +17,9 @@
 //     (kRetainedNearMm .. kRetainedFarMm from it): 0 flat, 180 folded flat;
 //   max_stretch: the largest relative stretch of an edge of the truth grid (its rest length the
 //     grid spacing): torn above kTornStretch;
-//   off_table: a node more than kBelowTableMm below the table top (pushed over an edge);
+//   off_table: kOffTableFraction of the nodes or more lie over kBelowTableMm below the table
+//     top (pushed over an edge; a corner hanging over one, as the shift leaves it for the pinch,
+//     is not);
 //   slip_mm: the base's largest displacement from a reference state (the runner's choice).
 // Pure functions, non-RT.
 #pragma once
@@ -37,6 +39,7 @@ inline constexpr double kRetainedNearMm = 15.0;
 inline constexpr double kRetainedFarMm = 60.0;
 inline constexpr double kTornStretch = 0.05;
 inline constexpr double kBelowTableMm = 2.0;
+inline constexpr double kOffTableFraction = 0.25;
 
 // What the fold intends (from its sequence file).
 struct FoldTarget {

@@ -3,7 +3,9 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <memory>
 
 using namespace crease;
@@ -40,4 +42,36 @@ TEST_CASE("origin at node (0, 0), x along u, z = u x v; degenerate states are re
   CHECK_FALSE(sheet_frame_m(*s, f));
   s->nodes_v = 1;
   CHECK_FALSE(sheet_frame_m(*s, f));
+}
+
+TEST_CASE("the frame stays with the sheet's base while its far half is folded up") {
+  // The world's sheet on a 3 x 5 grid, flat; then the half v > 148.5 turned up about the
+  // crease v = 148.5 by 90 deg (the half fold's bend at its second via point).
+  auto s = std::make_unique<SheetState>();
+  s->nodes_u = 3;
+  s->nodes_v = 5;
+  auto lay = [&](double bend_rad) {
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 3; ++i) {
+        float* p = s->position_mm[j * 3 + i];
+        const double v = 74.25 * j, past = std::max(0.0, v - 148.5);
+        p[0] = static_cast<float>(-105.0 + 105.0 * i);
+        p[1] = static_cast<float>(148.5 - std::min(v, 148.5) - past * std::cos(bend_rad));
+        p[2] = static_cast<float>(0.1 + past * std::sin(bend_rad));
+      }
+  };
+  lay(0.0);
+  KDL::Frame flat, bent;
+  REQUIRE(sheet_frame_m(*s, flat));
+  lay(std::numbers::pi / 2);
+  REQUIRE(sheet_frame_m(*s, bent));
+  CHECK(norm(bent.p - flat.p) < 1e-9);
+  CHECK(norm(bent.M.UnitZ() - flat.M.UnitZ()) < 1e-6);
+  CHECK(norm(bent.M.UnitY() - flat.M.UnitY()) < 1e-6);
+  // From the far corner (node (0, H-1)), as before, the frame would have turned 45 deg.
+  const KDL::Vector o(s->position_mm[0][0], s->position_mm[0][1], s->position_mm[0][2]);
+  const KDL::Vector c(s->position_mm[12][0], s->position_mm[12][1], s->position_mm[12][2]);
+  KDL::Vector x(1, 0, 0), z = x * (c - o);
+  z.Normalize();
+  CHECK(std::acos(KDL::dot(z, flat.M.UnitZ())) == doctest::Approx(std::numbers::pi / 4).epsilon(0.01));
 }

@@ -188,8 +188,11 @@ TEST_CASE("a torn sheet, one pushed off the table and a base that slipped are to
     CHECK_FALSE(r.shape_ok);
     CHECK(r.miss.find("torn") == 0);
   }
-  SUBCASE("off the table: a corner 30 mm below its top") {
+  SUBCASE("off the table: a third of the sheet hanging 40 mm below its top; a corner hanging over an edge is not") {
     s->position_mm[0][2] = -30.0f;
+    CHECK_FALSE(score_sheet(*s, target(kHalf, kHalfCorner), Bounds{}).off_table);
+    for (int j = 0; j < 7; ++j)
+      for (int i = 0; i < 15; ++i) s->position_mm[j * 15 + i][2] = -40.0f;
     const Score r = score_sheet(*s, target(kHalf, kHalfCorner), Bounds{});
     CHECK(r.off_table);
     CHECK_FALSE(r.shape_ok);
