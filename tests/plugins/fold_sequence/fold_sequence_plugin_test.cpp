@@ -165,7 +165,7 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
     for (int c = 0; c < 3; ++c) CHECK(near(g.position_mm[0][c], via[k][c]));
     CHECK(g.speed_mm_s == 40.0f);
   }
-  CHECK(near(left[3]->arm_goal.orientation[0][0], -0.70711));  // 90 deg about -u: the wrist turns
+  CHECK(near(left[3]->arm_goal.orientation[0][0], -0.49265));  // the pinched pad turned 90 deg about -u
   // (g) the hardening stroke along the model's crease, inset 10 mm, 4 mm onto the stack.
   const Sent* hs = nullptr;
   for (const Sent* s : left)

@@ -107,7 +107,7 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(e.find("fold.bend.via[1].at_mm: expected a list of 3 numbers") != std::string::npos);
   }
   SUBCASE("a quaternion off unit length") {
-    const std::string e = error_of(variant("[-0.70711, 0, 0, 0.70711]", "[-0.7, 0, 0, 0.9]"));
+    const std::string e = error_of(variant("[-0.49265, -0.50725, 0.50725, 0.49265]", "[-0.7, 0, 0, 0.9]"));
     CHECK(e.find("fold.bend.via[1].orientation: must be a unit quaternion") != std::string::npos);
   }
   SUBCASE("a timeout of a state that does not exist") {
