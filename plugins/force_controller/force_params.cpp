@@ -18,11 +18,11 @@ std::array<double, kJoints> default_alpha() {
   return a;
 }
 
-std::array<double, kJoints> read_alpha(const Params& p) {
-  if (!p.has("alpha")) return default_alpha();
-  const YAML::Node node = p.raw("alpha");
-  const Params map = p.child("alpha");
-  std::array<double, kJoints> out{};
+// Each key of the map KEY, a hand joint's name, with its index; an unknown name fails naming it.
+template <typename Each>
+void for_each_joint(const Params& p, const std::string& key, Each each) {
+  const YAML::Node node = p.raw(key);
+  const Params map = p.child(key);
   const std::vector<std::string> names(robot::kHandJointNames.begin(), robot::kHandJointNames.end());
   for (auto it = node.begin(); it != node.end(); ++it) {
     const std::string name = it->first.as<std::string>();
@@ -31,10 +31,19 @@ std::array<double, kJoints> read_alpha(const Params& p) {
       const std::string guess = config::did_you_mean(name, names);
       map.fail(name, "unknown joint '" + name + "'" + (guess.empty() ? "" : " (did you mean '" + guess + "'?)"));
     }
-    if (!robot::is_finger_flexion_joint(j))
-      map.fail(name, "not a finger's flexion joint (J3 or J2 of ff, mf, rf, lf; the thumb is excluded)");
-    out[static_cast<std::size_t>(j)] = map.get_in_range<double>(name, 0.0, 0.0, 10.0);
+    each(map, name, j);
   }
+}
+
+std::array<double, kJoints> read_alpha(const Params& p) {
+  if (!p.has("alpha")) return default_alpha();
+  const Params map = p.child("alpha");
+  std::array<double, kJoints> out{};
+  for_each_joint(p, "alpha", [&](const Params& m, const std::string& name, int j) {
+    if (!robot::is_finger_flexion_joint(j))
+      m.fail(name, "not a finger's flexion joint (J3 or J2 of ff, mf, rf, lf; the thumb is excluded)");
+    out[static_cast<std::size_t>(j)] = m.get_in_range<double>(name, 0.0, 0.0, 10.0);
+  });
   // Seed 000: stronger flexion of the proximal joints, or the fingers curl in.
   for (int j = 0; j < kJoints; ++j) {
     const std::string_view n = robot::kHandJointNames[static_cast<std::size_t>(j)];
@@ -51,18 +60,9 @@ std::array<double, kJoints> read_alpha(const Params& p) {
 std::array<double, kJoints> read_stiffness(const Params& p) {
   std::array<double, kJoints> out = filled(p.get_in_range<double>("default_stiffness", 2.0, 0.0, 655.35));
   if (!p.has("joint_stiffness")) return out;
-  const YAML::Node node = p.raw("joint_stiffness");
-  const Params map = p.child("joint_stiffness");
-  const std::vector<std::string> names(robot::kHandJointNames.begin(), robot::kHandJointNames.end());
-  for (auto it = node.begin(); it != node.end(); ++it) {
-    const std::string name = it->first.as<std::string>();
-    const int j = robot::hand_joint_index(name);
-    if (j < 0) {
-      const std::string guess = config::did_you_mean(name, names);
-      map.fail(name, "unknown joint '" + name + "'" + (guess.empty() ? "" : " (did you mean '" + guess + "'?)"));
-    }
-    out[static_cast<std::size_t>(j)] = map.get_in_range<double>(name, 0.0, 0.0, 655.35);
-  }
+  for_each_joint(p, "joint_stiffness", [&](const Params& m, const std::string& name, int j) {
+    out[static_cast<std::size_t>(j)] = m.get_in_range<double>(name, 0.0, 0.0, 655.35);
+  });
   return out;
 }
 
