@@ -112,6 +112,35 @@ void on_status(LinkCounters& c, const dds_subscription_matched_status_t& s);
 void catch_up_statuses(dds_entity_t reader, LinkCounters& c);
 // Publisher thread: the writer's matched and incompatible-QoS statuses into `c`.
 void take_writer_statuses(dds_entity_t writer, LinkCounters& c);
+
+// A reader's data listener: takes every sample waiting at READER, kBatch at a time, checks each
+// into STAGING (D::from_dds), counts the malformed and oversized ones in C, and calls ACCEPT for
+// each good one (which counts it and hands it on); Cyclone's loans are returned.
+template <class D, int kBatch, class Staging, class Accept>
+void take_samples(dds_entity_t reader, Staging& staging, LinkCounters& c, Accept accept) {
+  void* samples[kBatch] = {};
+  dds_sample_info_t infos[kBatch];
+  for (;;) {
+    const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
+    if (n <= 0) break;
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      switch (D::from_dds(*static_cast<const typename D::C*>(samples[i]), staging)) {
+        case SampleCheck::ok:
+          accept();
+          break;
+        case SampleCheck::malformed:
+          c.malformed.fetch_add(1, std::memory_order_relaxed);
+          break;
+        case SampleCheck::oversized:
+          c.oversized.fetch_add(1, std::memory_order_relaxed);
+          break;
+      }
+    }
+    dds_return_loan(reader, samples, n);
+    if (n < kBatch) break;
+  }
+}
 // The same kept current by listeners on `writer` (Cyclone's threads), for a link that writes
 // rarely (queue topics); `c` must outlive the writer. Throws crease::Error when refused.
 void listen_to_writer(dds_entity_t writer, LinkCounters& c);
@@ -184,31 +213,11 @@ class SubscribeLinkT final : public SubscribeLink {
 
   void receive() override {
     const std::lock_guard lock(receiving_);
-    constexpr int kBatch = 8;
-    void* samples[kBatch] = {};
-    dds_sample_info_t infos[kBatch];
-    for (;;) {
-      const dds_return_t n = dds_take(endpoint_.handle(), samples, infos, kBatch, kBatch);
-      if (n <= 0) break;
-      for (int i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
-        switch (D::from_dds(*static_cast<const typename D::C*>(samples[i]), *staging_)) {
-          case SampleCheck::ok:
-            channel_.write(staging_.get(), rt::now_ns());  // stamped with its arrival here
-            counters().samples.fetch_add(1, std::memory_order_relaxed);
-            counters().stale.store(false, std::memory_order_release);  // after the value is in
-            break;
-          case SampleCheck::malformed:
-            counters().malformed.fetch_add(1, std::memory_order_relaxed);
-            break;
-          case SampleCheck::oversized:
-            counters().oversized.fetch_add(1, std::memory_order_relaxed);
-            break;
-        }
-      }
-      dds_return_loan(endpoint_.handle(), samples, n);
-      if (n < kBatch) break;
-    }
+    take_samples<D, 8>(endpoint_.handle(), *staging_, counters(), [this] {
+      channel_.write(staging_.get(), rt::now_ns());  // stamped with its arrival here
+      counters().samples.fetch_add(1, std::memory_order_relaxed);
+      counters().stale.store(false, std::memory_order_release);  // after the value is in
+    });
   }
 
   bool give_rt() noexcept override {

@@ -98,30 +98,10 @@ class QueueSubscribeLinkT final : public SubscribeLink {
 
   void receive() override {
     const std::lock_guard lock(receiving_);
-    constexpr int kBatch = 16;
-    void* samples[kBatch] = {};
-    dds_sample_info_t infos[kBatch];
-    for (;;) {
-      const dds_return_t n = dds_take(endpoint_.handle(), samples, infos, kBatch, kBatch);
-      if (n <= 0) break;
-      for (int i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
-        switch (D::from_dds(*static_cast<const typename D::C*>(samples[i]), staging_)) {
-          case SampleCheck::ok:
-            counters().samples.fetch_add(1, std::memory_order_relaxed);
-            if (!channel_.try_push(&staging_)) counters().queue_full.fetch_add(1, std::memory_order_relaxed);
-            break;
-          case SampleCheck::malformed:
-            counters().malformed.fetch_add(1, std::memory_order_relaxed);
-            break;
-          case SampleCheck::oversized:
-            counters().oversized.fetch_add(1, std::memory_order_relaxed);
-            break;
-        }
-      }
-      dds_return_loan(endpoint_.handle(), samples, n);
-      if (n < kBatch) break;
-    }
+    take_samples<D, 16>(endpoint_.handle(), staging_, counters(), [this] {
+      counters().samples.fetch_add(1, std::memory_order_relaxed);
+      if (!channel_.try_push(&staging_)) counters().queue_full.fetch_add(1, std::memory_order_relaxed);
+    });
   }
 
   bool give_rt() noexcept override {
