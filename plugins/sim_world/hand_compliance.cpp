@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace crease::world {
 namespace {
@@ -42,6 +43,7 @@ void HandCompliance::configure(const Limits& limits, int max_contacts) {
   limits_ = limits;
   g_.assign(static_cast<std::size_t>(std::max(0, max_contacts)), Joints{});
   on_.assign(g_.size(), 0);
+  g_old_.assign(g_.size(), 0.0);
   truncated_ = 0;
 }
 
@@ -68,6 +70,11 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     return;
   }
   const Joints old = dq;
+  double* g_old = g_old_.data();  // g_c . dq_old per contact: fixed for the solve
+  for (int c = 0; c < nc; ++c) {
+    g_old[c] = 0;
+    for (int j = 0; j < kN; ++j) g_old[c] += g_[c][j] * old[j];
+  }
   // The box each joint's deflection stays in: its limits, and within max_step_rad of the last.
   double lo[kN], hi[kN], k_full[kN], tmax[kN], k_eff[kN];
   for (int j = 0; j < kN; ++j) {
@@ -126,29 +133,32 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     // A joint at a bound stays there while the potential falls beyond it.
     for (int j = 0; j < kN; ++j) locked[j] = (cur[j] <= lo[j] + kAtBoundRad && grad[j] > 0) || (cur[j] >= hi[j] - kAtBoundRad && grad[j] < 0);
 
+    // The Newton system at this point, before any joint is held: the springs' secant stiffness
+    // and the pressing contacts.
+    double a0[kN][kN] = {}, r0[kN];
+    for (int j = 0; j < kN; ++j) {
+      r0[j] = tau_external[j];
+      a0[j][j] = kEpsNmmPerRad + k_eff[j];
+    }
+    for (int c = 0; c < nc; ++c) {
+      if (!on[c]) continue;
+      const double kc = contacts[c].stiffness_n_per_mm;
+      const double rc = -kc * (contacts[c].depth_mm - g_old[c]);
+      for (int i = 0; i < kN; ++i) {
+        const double gi = g_[c][i];
+        if (gi == 0.0) continue;
+        r0[i] += rc * gi;
+        for (int j = 0; j < kN; ++j) a0[i][j] += kc * gi * g_[c][j];
+      }
+    }
     // The Newton step over the free joints. A free joint at a bound that the step would take
     // past it is held there too, and the step solved again: what is left descends.
     double r[kN];
     bool solved = false;
     for (int again = 0; again <= kN; ++again) {
-      double a[kN][kN] = {};
-      for (int j = 0; j < kN; ++j) {
-        r[j] = tau_external[j];
-        a[j][j] = kEpsNmmPerRad + k_eff[j];
-      }
-      for (int c = 0; c < nc; ++c) {
-        if (!on[c]) continue;
-        const double kc = contacts[c].stiffness_n_per_mm;
-        double gd = 0;
-        for (int j = 0; j < kN; ++j) gd += g_[c][j] * old[j];
-        const double rc = -kc * (contacts[c].depth_mm - gd);
-        for (int i = 0; i < kN; ++i) {
-          const double gi = g_[c][i];
-          if (gi == 0.0) continue;
-          r[i] += rc * gi;
-          for (int j = 0; j < kN; ++j) a[i][j] += kc * gi * g_[c][j];
-        }
-      }
+      double a[kN][kN];
+      std::memcpy(a, a0, sizeof a);
+      std::memcpy(r, r0, sizeof r);
       for (int j = 0; j < kN; ++j) {
         if (!locked[j]) continue;
         for (int i = 0; i < kN; ++i) {
@@ -209,8 +219,6 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     }
   }
   for (int j = 0; j < kN; ++j) dq[j] = cur[j];
-  saturated_ = 0;
-  at_limit_ = 0;
   for (int j = 0; j < kN; ++j) {
     const double q = target[j] + cur[j];
     // At a limit and pushing into it (as the last round found it).

@@ -83,6 +83,7 @@ class HandCompliance {
   Limits limits_;
   std::vector<Joints> g_;          // J^T n per contact, mm/rad
   std::vector<std::uint8_t> on_;  // per contact: pushing in the current round
+  std::vector<double> g_old_;     // per contact: g . dq_old (mm), fixed for a solve
   std::uint64_t truncated_ = 0;
   double max_step_rad_ = 1e300;
   int saturated_ = 0, at_limit_ = 0, rounds_ = 0;

@@ -73,6 +73,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
     sheet_->set_positions(x);
   }
 
+  std::array<HandCompliance::Limits, robot::kSides> hand_limits{};  // the balances', configured below
   for (int s = 0; s < robot::kSides; ++s) {
     const Side side = static_cast<Side>(s);
     kin_[s] = std::make_unique<SideKinematics>(model, side);
@@ -97,7 +98,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
       h.stiffness[j] = h.stiffness_cmd[j] = params_.initial_stiffness_nm_per_rad;
     }
     compliance_[s] = std::make_unique<HandCompliance>();
-    compliance_limits_[s] = lim;  // configured below, once the contacts' worst case is known
+    hand_limits[s] = lim;  // configured once the contacts' worst case is known
     const std::string& prefix = model.params().side(side).prefix;
     for (int f = 0; f < robot::kFingertips; ++f) {
       h.tip_link[f] = kin_[s]->link_index(prefix + std::string(robot::kFingertipNames[f]) + "pad");
@@ -125,7 +126,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : model_
     hand_contact_shape_[s].resize(cap);
     hand_contact_shape2_[s].resize(cap);
     hand_contact_force_[s].resize(cap);
-    compliance_[s]->configure(compliance_limits_[s], static_cast<int>(cap));
+    compliance_[s]->configure(hand_limits[s], static_cast<int>(cap));
     compliance_[s]->set_max_step_rad(kMaxDeflectionStepRad);
   }
   shape_normal_n_.assign(shapes_.size(), 0.0);

@@ -137,7 +137,6 @@ class World {
   FingerContacts contacts_;
   std::array<HandSim, robot::kSides> hand_;
   std::array<std::unique_ptr<HandCompliance>, robot::kSides> compliance_;
-  std::array<HandCompliance::Limits, robot::kSides> compliance_limits_{};
   // Per side, this step: the contacts the hand settled against, their shapes and forces (N).
   std::array<std::vector<HandCompliance::Contact>, robot::kSides> hand_contacts_;
   std::array<std::vector<int>, robot::kSides> hand_contact_shape_, hand_contact_shape2_;
