@@ -20,6 +20,10 @@ namespace crease::test {
 inline int test_domain() { return 1 + static_cast<int>(::getpid() % 200); }
 // A topic name of this test process: "t<pid>/<name>".
 inline std::string test_topic(const std::string& name) { return "t" + std::to_string(::getpid()) + "/" + name; }
+// A bridge's params in this process's domain with LINKS ("publish: [...]", "subscribe: [...]").
+inline std::string bridge_params(const std::string& links) {
+  return "{domain: " + std::to_string(test_domain()) + ", " + links + "}";
+}
 
 struct BridgeHost {
   PluginHost host{{CREASE_PLUGIN_DIR}};

@@ -13,14 +13,12 @@
 
 using namespace crease;
 using crease::test::BridgeHost;
+using crease::test::bridge_params;
 using crease::test::eventually;
 using crease::test::test_domain;
 using crease::test::test_topic;
 
 namespace {
-std::string bridge_params(const std::string& links) {
-  return "{domain: " + std::to_string(test_domain()) + ", " + links + "}";
-}
 // A publishes hand_state (1 kHz) and keypoints (every 10 cycles, 300 points) on topic `tag`.
 void add_publisher(BridgeHost& a, const std::string& tag, const std::string& qos = "") {
   a.add("source", "crease_test_payload_source", 0, "{keypoints_every: 10, keypoints_count: 300}");

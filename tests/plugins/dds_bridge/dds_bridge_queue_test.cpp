@@ -16,19 +16,19 @@
 #include "SheetMemorizeEvent.h"
 #include "bridge_fixture.h"
 #include "core/port_types/sheet_state.h"
+#include "raw_writer.h"
 #include "rogue_sheet_edit.h"
 #include "rt/alloc_guard.h"
 
 using namespace crease;
 using crease::test::BridgeHost;
+using crease::test::bridge_params;
 using crease::test::eventually;
+using crease::test::raw_writer;
 using crease::test::test_domain;
 using crease::test::test_topic;
 
 namespace {
-std::string bridge_params(const std::string& links) {
-  return "{domain: " + std::to_string(test_domain()) + ", " + links + "}";
-}
 // A publishes the queue ports sheet_crease and sheet_memorize (only memorize: `crease` false).
 void add_publisher(BridgeHost& a, const std::string& tag, bool crease = true) {
   const std::string memorize = "{port: sheet_memorize, topic: " + test_topic(tag + "/memorize") + ", type: sheet_memorize}";
@@ -246,20 +246,8 @@ TEST_CASE("bad events from the network are counted and dropped, never pushed int
   b.host.start();
   const dds_entity_t pp = dds_create_participant(static_cast<dds_domainid_t>(test_domain()), nullptr, nullptr);
   REQUIRE(pp > 0);
-  dds_qos_t* q = dds_create_qos();
-  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-  dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
-  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(500));  // within the bridge's 1000 ms lease
   const auto writer = [&](const dds_topic_descriptor_t* type, const std::string& topic) {
-    const dds_entity_t t = dds_create_topic(pp, type, ("rt/" + test_topic(topic)).c_str(), q, nullptr);
-    REQUIRE(t > 0);
-    const dds_entity_t w = dds_create_writer(pp, t, q, nullptr);
-    REQUIRE(w > 0);
-    REQUIRE(eventually([&] {
-      dds_publication_matched_status_t m;
-      return dds_get_publication_matched_status(w, &m) == 0 && m.current_count == 1;
-    }));
-    return w;
+    return raw_writer(pp, type, test_topic(topic), true);
   };
   const dds_entity_t cw = writer(&crease_msgs_msg_dds__SheetCreaseEvent__desc, "bad/crease");
   const dds_entity_t mw = writer(&crease_msgs_msg_dds__SheetMemorizeEvent__desc, "bad/memorize");
@@ -317,14 +305,7 @@ TEST_CASE("bad events from the network are counted and dropped, never pushed int
                                           r.restrict_data_representation};
   const dds_entity_t pp2 = dds_create_participant(static_cast<dds_domainid_t>(test_domain()), nullptr, nullptr);
   REQUIRE(pp2 > 0);
-  const dds_entity_t rt = dds_create_topic(pp2, &look_alike, ("rt/" + test_topic("bad/crease")).c_str(), q, nullptr);
-  REQUIRE(rt > 0);
-  const dds_entity_t rw = dds_create_writer(pp2, rt, q, nullptr);
-  REQUIRE(rw > 0);
-  REQUIRE(eventually([&] {
-    dds_publication_matched_status_t s;
-    return dds_get_publication_matched_status(rw, &s) == 0 && s.current_count == 1;
-  }));
+  const dds_entity_t rw = raw_writer(pp2, &look_alike, test_topic("bad/crease"), true);
   rogue_msgs_msg_dds__SheetCreaseEvent_ short_one{9, 0};
   REQUIRE(dds_write(rw, &short_one) == 0);
   REQUIRE(eventually([&] { return b.stats("bridge").topics[0].undecodable == 1; }));
@@ -333,7 +314,6 @@ TEST_CASE("bad events from the network are counted and dropped, never pushed int
   CHECK(drain<SheetCreaseEvent>(queue(b, "sheet_crease")).empty());
   CHECK(b.stats("bridge").topics[0].port_writes == 2);
   CHECK(b.state("bridge") == RunState::active);
-  dds_delete_qos(q);
   dds_delete(pp2);
   dds_delete(pp);
   b.host.stop();

@@ -13,31 +13,17 @@
 #include "bridge_fixture.h"
 #include "core/port_types/hand.h"
 #include "core/port_types/keypoints.h"
+#include "raw_writer.h"
 #include "rogue_keypoints.h"
 
 using namespace crease;
 using crease::test::BridgeHost;
 using crease::test::eventually;
+using crease::test::raw_writer;
 using crease::test::test_domain;
 using crease::test::test_topic;
 
 namespace {
-// A raw writer of `type` on `topic` with QoS the bridge's default reader accepts.
-dds_entity_t raw_writer(dds_entity_t pp, const dds_topic_descriptor_t* type, const std::string& topic) {
-  dds_qos_t* q = dds_create_qos();
-  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-  dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(500));
-  const dds_entity_t t = dds_create_topic(pp, type, ("rt/" + topic).c_str(), q, nullptr);
-  REQUIRE(t > 0);
-  const dds_entity_t w = dds_create_writer(pp, t, q, nullptr);
-  dds_delete_qos(q);
-  REQUIRE(w > 0);
-  REQUIRE(eventually([&] {
-    dds_publication_matched_status_t m;
-    return dds_get_publication_matched_status(w, &m) == 0 && m.current_count == 1;
-  }));
-  return w;
-}
 
 struct RoguePoints {
   std::vector<rogue_msgs_msg_dds__Keypoint_> points;
