@@ -15,12 +15,6 @@ using namespace rig;
 
 namespace {
 
-Joints q_cmd(const Rig& r) {
-  Joints q{};
-  for (int j = 0; j < robot::kArmJoints; ++j) q[j] = r.motion->state().q_cmd[j];
-  return q;
-}
-
 KDL::Frame shifted(const KDL::Frame& f, double dx_mm, double dy_mm, double dz_mm, const KDL::Rotation& turn = {}) {
   return KDL::Frame(turn * f.M, f.p + KDL::Vector(dx_mm, dy_mm, dz_mm) / 1000.0);
 }

@@ -21,13 +21,6 @@ using namespace rig;
 
 namespace {
 
-// The command's joint angles in double (the controller's own q_cmd; the port carries floats).
-Joints q_cmd(const Rig& r) {
-  Joints q{};
-  for (int j = 0; j < robot::kArmJoints; ++j) q[j] = r.motion->state().q_cmd[j];
-  return q;
-}
-
 // Speeds and accelerations of the tool frame along the cycles (from FK of q_cmd).
 struct Trace {
   std::vector<KDL::Frame> pose;

@@ -157,6 +157,13 @@ inline void add_point(ArmGoal& g, const KDL::Frame& pose) {
   pose.M.GetQuaternion(g.orientation[k][0], g.orientation[k][1], g.orientation[k][2], g.orientation[k][3]);
 }
 
+// The command's joint angles in double (the controller's own q_cmd; the port carries floats).
+inline Joints q_cmd(const Rig& r) {
+  Joints q{};
+  for (int j = 0; j < robot::kArmJoints; ++j) q[j] = r.motion->state().q_cmd[j];
+  return q;
+}
+
 // Exact at small differences (KDL's Norm and diff read values under 1e-6 as 0).
 inline double norm(const KDL::Vector& v) { return std::sqrt(KDL::dot(v, v)); }
 inline double mm(const KDL::Vector& v) { return 1000.0 * norm(v); }
