@@ -2,6 +2,7 @@
 // its steady-state updates allocate nothing (the loop thread is RT-marked).
 #include <doctest/doctest.h>
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <thread>
@@ -18,17 +19,24 @@ using namespace std::chrono_literals;
 
 namespace {
 
+// The sheet instance in the model loop. No time budget: the tests check what the model
+// computes, and a sanitizer build on a slow machine takes longer than the 120 Hz period.
+crease::InstanceSpec sheet_spec(const char* yaml) {
+  crease::InstanceSpec s;
+  s.name = "sheet";
+  s.library = "sheet_model";
+  s.loop = "model";
+  s.params = crease::Params(YAML::Load(yaml), "test.yaml", "sheet.params");
+  s.budget_ns = 0;
+  return s;
+}
+
 struct Fixture {
   crease::PluginHost host{{CREASE_PLUGIN_DIR}};
   std::unique_ptr<crease::SheetState> state = std::make_unique<crease::SheetState>();
   Fixture() {
     host.add_loop({"model", 120.0, 0, -1});  // faster than the default 60 Hz: a shorter test
-    crease::InstanceSpec s;
-    s.name = "sheet";
-    s.library = "sheet_model";
-    s.loop = "model";
-    s.params = crease::Params(YAML::Load("{substeps: 4}"), "test.yaml", "sheet.params");
-    host.add_instance(s);
+    host.add_instance(sheet_spec("{substeps: 4}"));
   }
   const crease::SheetState& read() {
     const auto* ch = host.ports().find_latest("sheet_state");
@@ -65,31 +73,18 @@ TEST_CASE_FIXTURE(Fixture, "the plugin publishes a finite sheet state and alloca
 TEST_CASE("self_collision_every is a validated parameter, named in the error") {
   crease::PluginHost host{{CREASE_PLUGIN_DIR}};
   host.add_loop({"model", 120.0, 0, -1});
-  auto spec = [](const char* yaml) {
-    crease::InstanceSpec s;
-    s.name = "sheet";
-    s.library = "sheet_model";
-    s.loop = "model";
-    s.params = crease::Params(YAML::Load(yaml), "test.yaml", "sheet.params");
-    return s;
-  };
-  CHECK_THROWS_WITH_AS(host.add_instance(spec("{substeps: 4, self_collision_every: 0}")),
+  CHECK_THROWS_WITH_AS(host.add_instance(sheet_spec("{substeps: 4, self_collision_every: 0}")),
                        doctest::Contains("self_collision_every"), std::exception);
-  CHECK_THROWS_WITH_AS(host.add_instance(spec("{substeps: 4, self_collision_every: 1000}")),
+  CHECK_THROWS_WITH_AS(host.add_instance(sheet_spec("{substeps: 4, self_collision_every: 1000}")),
                        doctest::Contains("self_collision_every"), std::exception);
-  CHECK_NOTHROW(host.add_instance(spec("{substeps: 4, self_collision_every: 1}")));
+  CHECK_NOTHROW(host.add_instance(sheet_spec("{substeps: 4, self_collision_every: 1}")));
 }
 
 TEST_CASE("coupling is springs or keypoints, anything else an error naming the key") {
   auto configure = [](const char* yaml) {  // one host each: the ports have one writer, one reader
     crease::PluginHost host{{CREASE_PLUGIN_DIR}};
     host.add_loop({"model", 120.0, 0, -1});
-    crease::InstanceSpec s;
-    s.name = "sheet";
-    s.library = "sheet_model";
-    s.loop = "model";
-    s.params = crease::Params(YAML::Load(yaml), "test.yaml", "sheet.params");
-    host.add_instance(s);
+    host.add_instance(sheet_spec(yaml));
   };
   CHECK_THROWS_WITH_AS(configure("{substeps: 4, coupling: velocities}"),
                        doctest::Contains("sheet.params.coupling: must be springs or keypoints, not 'velocities'"),
@@ -105,12 +100,7 @@ TEST_CASE("coupling is springs or keypoints, anything else an error naming the k
 double mean_z_after_lift(const char* params) {
   crease::PluginHost host{{CREASE_PLUGIN_DIR}};
   host.add_loop({"model", 120.0, 0, -1});
-  crease::InstanceSpec s;
-  s.name = "sheet";
-  s.library = "sheet_model";
-  s.loop = "model";
-  s.params = crease::Params(YAML::Load(params), "test.yaml", "sheet.params");
-  host.add_instance(s);
+  host.add_instance(sheet_spec(params));
   auto* kp_port = host.ports().bind_latest_writer("keypoints", crease::port_type_of<crease::Keypoints>(), "test");
   auto kp = std::make_unique<crease::Keypoints>();
   const auto layout = crease::sheet::marker_keypoints(crease::sheet::SyntheticMarkerGrid{});
@@ -152,4 +142,38 @@ TEST_CASE("the coupling parameter reaches the model: springs, or key-point veloc
   CHECK(springs > 30.0);                // the springs lift it whatever the gain
   CHECK(keypoints > 20.0);              // lambda = 10/s: a 0.1 s time constant, 0.5 s here
   CHECK(keypoints_no_gain < 1.0);       // no pull at all: it stays on the table (0.5 mm)
+}
+
+TEST_CASE("turn_deg lays the flat sheet turned about its corner (0, 0); out of range it is an error naming the key") {
+  auto corners = [](const char* params) {
+    crease::PluginHost host{{CREASE_PLUGIN_DIR}};
+    host.add_loop({"model", 120.0, 0, -1});
+    host.add_instance(sheet_spec(params));
+    auto state = std::make_unique<crease::SheetState>();
+    const auto* out = host.ports().find_latest("sheet_state");
+    REQUIRE(out != nullptr);
+    host.start();
+    const bool seen = crease::testing::poll_until(
+        host, [&] { return out->read(state.get(), 0).has_data() && state->step > 2; }, std::chrono::seconds(5));
+    host.stop();
+    REQUIRE(seen);
+    const int w = state->nodes_u, h = state->nodes_v;
+    std::array<std::array<float, 2>, 3> c{};  // nodes (0, 0), (W-1, 0), (0, H-1): x, y
+    const int k[3] = {0, w - 1, (h - 1) * w};
+    for (int i = 0; i < 3; ++i) c[static_cast<std::size_t>(i)] = {state->position_mm[k[i]][0], state->position_mm[k[i]][1]};
+    return c;
+  };
+  const auto turned = corners("{substeps: 4, origin_x_mm: 105, origin_y_mm: -148.5, turn_deg: 180}");
+  CHECK(turned[0][0] == doctest::Approx(105.0).epsilon(0.01));
+  CHECK(turned[0][1] == doctest::Approx(-148.5).epsilon(0.01));
+  CHECK(turned[1][0] == doctest::Approx(-105.0).epsilon(0.01));  // u along -x
+  CHECK(turned[2][1] == doctest::Approx(148.5).epsilon(0.01));   // v along +y
+  // Failing variant: unturned, the same origin lays u along +x and v along -y.
+  const auto plain = corners("{substeps: 4, origin_x_mm: 105, origin_y_mm: -148.5}");
+  CHECK(plain[1][0] == doctest::Approx(315.0).epsilon(0.01));
+  CHECK(plain[2][1] == doctest::Approx(-445.5).epsilon(0.01));
+  crease::PluginHost host{{CREASE_PLUGIN_DIR}};
+  host.add_loop({"model", 120.0, 0, -1});
+  CHECK_THROWS_WITH_AS(host.add_instance(sheet_spec("{substeps: 4, turn_deg: 200}")), doctest::Contains("sheet.params.turn_deg"),
+                       std::exception);
 }
