@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "core/assert.h"
@@ -76,7 +77,8 @@ SheetModel::SheetModel(const SheetParams& params)
 
 Vec3 SheetModel::flat_position(Vec2 p) const noexcept {
   const Vec3& o = params_.grid.origin_mm;
-  return {o.x + p.u, o.y - p.v, o.z};
+  const double a = params_.grid.turn_deg * std::numbers::pi / 180.0, c = std::cos(a), s = std::sin(a);
+  return {o.x + c * p.u + s * p.v, o.y + s * p.u - c * p.v, o.z};
 }
 
 void SheetModel::reset_rt() noexcept {

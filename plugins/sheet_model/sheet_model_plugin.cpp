@@ -9,7 +9,7 @@
 // (positions and link state) and the update returns degraded (counted in
 // sheet_state.rollbacks).
 // Parameters (all optional): nodes_u, nodes_v, width_mm, height_mm, density_g_per_m2,
-// thickness_mm, origin_x_mm, origin_y_mm, origin_z_mm, substeps,
+// thickness_mm, origin_x_mm, origin_y_mm, origin_z_mm, turn_deg, substeps,
 // coupling (how the key-points pull the model: `springs` (default), seed 001's zero-length
 // springs of compliance target_compliance_m_per_n; or `keypoints`, seed 000's node-velocity
 // P-controller of gain keypoint_gain_per_s), keypoint_gain_per_s, target_compliance_m_per_n,
@@ -54,6 +54,7 @@ class SheetModelPlugin final : public Plugin {
     // World position of sheet point (0,0) when flat (u -> +x, v -> -y).
     sp.grid.origin_mm = {p.get<double>("origin_x_mm", 0.0), p.get<double>("origin_y_mm", sp.grid.height_mm),
                          p.get<double>("origin_z_mm", 0.5 * sp.grid.thickness_mm)};
+    sp.grid.turn_deg = p.get_in_range<double>("turn_deg", 0.0, -180.0, 180.0);  // about z through point (0,0)
     sp.solver.substeps = p.get_in_range<int>("substeps", 10, 1, 100);
     const std::string coupling = p.get<std::string>("coupling", "springs");
     if (!sheet::parse_coupling(coupling, sp.solver.coupling))

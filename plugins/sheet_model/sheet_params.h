@@ -16,8 +16,10 @@ struct GridParams {
   double height_mm = 297.0;              // extent along v
   double areal_density_g_per_m2 = 80.0;  // paper grammage
   double thickness_mm = 1.0;             // collision thickness (layers keep this apart)
-  // World position of sheet point (0,0) when flat; flat sheet: u -> +x, v -> -y (printed face up).
+  // World position of sheet point (0,0) when flat; flat sheet: u -> +x, v -> -y (printed face up),
+  // turned by turn_deg about z through that point (180: u -> -x, v -> +y).
   Vec3 origin_mm{0.0, 297.0, 0.5};
+  double turn_deg = 0.0;
 };
 
 enum class Diagonals { none, alternating, both };

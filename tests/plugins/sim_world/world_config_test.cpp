@@ -1,5 +1,6 @@
-// sim_world's table parameters: the table's extent (an edge to overhang) read as given, null
-// sides without an edge, and every malformed extent a ConfigError naming file, line and key.
+// sim_world's table and sheet parameters: the table's extent (an edge to overhang) read as given, null
+// sides without an edge, the sheet's turn; every malformed value a ConfigError naming file, line
+// and key.
 #include "plugins/sim_world/world_config.h"
 
 #include <doctest/doctest.h>
@@ -51,4 +52,12 @@ TEST_CASE("table_extent_mm: a malformed extent names file, line and key") {
     CHECK(e.find("sim.yaml:2") != std::string::npos);
     CHECK(e.find("table_extent_mm") != std::string::npos);
   }
+}
+
+TEST_CASE("sheet_turn_deg turns the world's sheet grid; out of range it names file, line and key") {
+  CHECK(read("").world.sheet.grid.turn_deg == 0.0);
+  CHECK(read("sheet_turn_deg: 180\n").world.sheet.grid.turn_deg == 180.0);
+  const std::string e = error_of("sheet_turn_deg: 181\n");
+  CHECK(e.find("sim.yaml:2") != std::string::npos);
+  CHECK(e.find("sheet_turn_deg") != std::string::npos);
 }
