@@ -162,7 +162,7 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
       const auto q = base.to_sheet(x[0], x[1]);
       const double d[2] = {p[0] - q[0], p[1] - q[1]};
       const double len = std::hypot(d[0], d[1]);
-      if (x[2] > kOnBaseMm || len < kFoldedMm) continue;
+      if (x[2] > kOnBaseMm || x[2] < -kBelowTableMm || len < kFoldedMm) continue;  // on the base, not hanging
       ++r.folded_nodes;
       nsum[0] += d[0] / len;
       nsum[1] += d[1] / len;

@@ -8,7 +8,8 @@
 // world (x, y) (least squares over its nodes); a flap node folded flat onto it lies, seen
 // through that motion, at the mirror image of its (u, v) about the fold line that was made.
 //   fold_line_mm, fold_angle_deg: that line, fitted from the flap nodes lying on the base
-//     (below kOnBaseMm, and at least kFoldedMm from where they would lie unfolded), against the
+//     (below kOnBaseMm and not kBelowTableMm under the table top, which a node hanging over the
+//     table's edge is, and at least kFoldedMm from where they would lie unfolded), against the
 //     intended one: its distance from the intended line's midpoint and the angle between them;
 //     NaN when fewer than half the flap's nodes lie folded on the base (no fold was made);
 //   corners_mm: the worst distance of the flap's sheet corners from where the intended fold puts

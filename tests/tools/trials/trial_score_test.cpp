@@ -113,6 +113,27 @@ TEST_CASE("an unfolded sheet scores as a failure: no fold, its corners a sheet's
   CHECK(t.failure.find("no fold") == 0);
 }
 
+TEST_CASE("a flap hanging over the table's edge is not folded onto the base; the same nodes lying on it would be") {
+  // The far end of the flap (v > 250) drawn 12 mm back towards the base and hanging 20 mm
+  // under the table top (the overhang the shift leaves for the pinch, drooping).
+  auto hung = [](double z_mm) {
+    const Pose pose{0, -105, 148.5};
+    auto s = sheet(pose);
+    for (int j = 0; j < 21; ++j)
+      for (int i = 0; i < 15; ++i) {
+        const double v = j * 297.0 / 20;
+        if (v <= 250) continue;
+        place(i * 15.0, v - 12.0, pose, s->position_mm[j * 15 + i], z_mm);
+      }
+    return score_sheet(*s, target(kHalf, kHalfCorner), Bounds{});
+  };
+  const Score hanging = hung(-20.0);
+  CHECK(hanging.folded_nodes == 0);
+  CHECK_FALSE(hanging.off_table);  // a few rows: not the sheet pushed off
+  // Failing variant: 1 mm up, as on top of the base, the same nodes count as folded.
+  CHECK(hung(1.0).folded_nodes > 0);
+}
+
 TEST_CASE("a perfect half fold scores as a success wherever the sheet lies") {
   for (const Pose pose : {Pose{}, Pose{-14, -80, 170}, Pose{9, -120, 130}}) {
     CAPTURE(pose.yaw_deg);
