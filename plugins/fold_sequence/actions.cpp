@@ -32,28 +32,41 @@ ArmGoal* next_arm_goal(int side, std::int64_t t_ns, std::uint32_t& next_id, Outb
   return &g;
 }
 
+static_assert(kMaxGraspPath + 1 <= ArmGoal::kMaxPoints, "the grasp's path and at_mm are one arm goal");
+
 }  // namespace
 
 void Machine::arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                        const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept {
+  const double path[1][3] = {{p[0], p[1], p[2]}};
+  const double turn[1][4] = {{q[0], q[1], q[2], q[3]}};
+  arm_path(side, tool, frame, 1, path, turn, lim, stop_fingers, out);
+}
+
+void Machine::arm_path(int side, std::uint8_t tool, std::uint8_t frame, int n, const double (*path_mm)[3],
+                       const double (*orientation)[4], const MotionLimits& lim, std::uint8_t stop_fingers,
+                       Outbox& out) noexcept {
   ArmGoal* goal = next_arm_goal(side, m_.last_ns, m_.next_id, out);
   if (goal == nullptr) return;
   ArmGoal& g = *goal;
+  n = n < 1 ? 1 : (n > ArmGoal::kMaxPoints ? ArmGoal::kMaxPoints : n);
   g.kind = ArmGoal::move;
   g.tool = tool;
   g.frame = frame;
-  g.point_count = 1;
+  g.point_count = static_cast<std::uint8_t>(n);
   g.stop_on = stop_fingers != 0 ? ArmGoal::contact_onset : ArmGoal::stop_none;
   g.stop_fingers = stop_fingers != 0 ? stop_fingers : 0x1f;
   set_limits(g, lim);
-  for (int c = 0; c < 3; ++c) g.position_mm[0][c] = p[c];
-  for (int c = 0; c < 4; ++c) g.orientation[0][c] = q[c];
+  for (int k = 0; k < n; ++k) {
+    for (int c = 0; c < 3; ++c) g.position_mm[k][c] = path_mm[k][c];
+    for (int c = 0; c < 4; ++c) g.orientation[k][c] = orientation[k][c];
+  }
   m_.arm_id[side] = g.id;
   m_.arm_has_target[side] = 1;
   m_.arm_frame[side] = frame;
   m_.arm_tool[side] = tool;
-  for (int c = 0; c < 3; ++c) m_.arm_target[side][c] = p[c];
-  for (int c = 0; c < 4; ++c) m_.arm_orientation[side][c] = q[c];
+  for (int c = 0; c < 3; ++c) m_.arm_target[side][c] = path_mm[n - 1][c];
+  for (int c = 0; c < 4; ++c) m_.arm_orientation[side][c] = orientation[n - 1][c];
 }
 
 void Machine::arm_stop(int side, Outbox& out) noexcept {
@@ -75,8 +88,9 @@ void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
 }
 
 void Machine::arm_park(int side, Outbox& out) noexcept {
-  arm_move(side, m_.arm_has_target[side] ? m_.arm_tool[side] : 0, ArmGoal::world, spec_.park_mm[side],
-           spec_.park_orientation[side], spec_.retreat, 0, out);
+  const int s = side == kPinching ? spec_.pinching_side : 1 - spec_.pinching_side;  // park poses are per side
+  arm_move(side, m_.arm_has_target[side] ? m_.arm_tool[side] : 0, ArmGoal::world, spec_.park_mm[s],
+           spec_.park_orientation[s], spec_.retreat, 0, out);
 }
 
 void Machine::push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) noexcept {
@@ -164,28 +178,45 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       m_.abort_reason = Reason::none;
       break;
     case S::shift_approach:
-      hand_posture(kRight, f.open_rad, in, out);
-      hand_posture(kLeft, f.open_rad, in, out);
-      approach(kRight, f.shift, out);
+      hand_posture(kFixing, f.open_rad, in, out);
+      hand_posture(kPinching, f.open_rad, in, out);
+      approach(kFixing, f.shift, out);
       break;
-    case S::shift_contact: descend(kRight, f.shift, out); break;
-    case S::shift_press: hand_force(kRight, f.shift.fingers, f.shift.force_n, in, out); break;
+    case S::shift_contact: descend(kFixing, f.shift, out); break;
+    case S::shift_press: hand_force(kFixing, f.shift.fingers, f.shift.force_n, in, out); break;
     case S::shift_slide: {
       double d[2] = {0, 0};
       const double len = slide_length(in, d);
       if (!std::isfinite(len)) d[0] = d[1] = 0;  // the guard saw a sheet; a stale one here moves nothing
       const double p[3] = {f.shift.at_mm[0] + d[0], f.shift.at_mm[1] + d[1], -f.slide_height_mm};
-      arm_move(kRight, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+      arm_move(kFixing, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
       break;
     }
-    case S::grasp_fixate: hand_force(kRight, f.shift.fingers, f.fixate_force_n, in, out); break;
-    case S::grasp_above:
-      arm_move(kLeft, f.grasp_tool, ArmGoal::sheet, f.grasp_above_mm, f.grasp_orientation, f.approach, 0, out);
+    case S::grasp_fixate: hand_force(kFixing, f.shift.fingers, f.fixate_force_n, in, out); break;
+    case S::grasp_shape: hand_posture(kPinching, f.prepinch_rad, in, out); break;
+    case S::grasp_above: {
+      double path[kMaxGraspPath + 1][3], turn[kMaxGraspPath + 1][4];
+      const int n = f.grasp_above_via_count;
+      for (int k = 0; k < n; ++k) {
+        for (int c = 0; c < 3; ++c) path[k][c] = f.grasp_above_via_mm[k][c];
+        for (int c = 0; c < 4; ++c) turn[k][c] = f.grasp_above_via_orientation[k][c];
+      }
+      for (int c = 0; c < 3; ++c) path[n][c] = f.grasp_above_mm[c];
+      for (int c = 0; c < 4; ++c) turn[n][c] = f.grasp_orientation[c];
+      arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n + 1, path, turn, f.approach, 0, out);
       break;
-    case S::grasp_reach:
-      arm_move(kLeft, f.grasp_tool, ArmGoal::sheet, f.grasp_at_mm, f.grasp_orientation, f.contact, 0, out);
+    }
+    case S::grasp_reach: {
+      double path[kMaxGraspPath + 1][3], turn[kMaxGraspPath + 1][4];
+      const int n = f.grasp_path_count;
+      for (int k = 0; k <= n; ++k) {
+        for (int c = 0; c < 3; ++c) path[k][c] = k < n ? f.grasp_path_mm[k][c] : f.grasp_at_mm[c];
+        for (int c = 0; c < 4; ++c) turn[k][c] = f.grasp_orientation[c];
+      }
+      arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n + 1, path, turn, f.contact, 0, out);
       break;
-    case S::grasp_pinch: hand_posture(kLeft, f.pinch_rad, in, out); break;
+    }
+    case S::grasp_pinch: hand_posture(kPinching, f.pinch_rad, in, out); break;
     case S::bend:
       // The crease the fold intends, in the tracked sheet's coordinates, so the model can bend.
       out.crease = SheetCreaseEvent{};
@@ -200,27 +231,27 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       break;
     case S::follow_via:
       if (m_.self_entry) ++m_.via;  // the next via point; re-entered on resume: the same one
-      arm_move(kLeft, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], f.via_orientation[m_.via], f.fold, 0, out);
+      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], f.via_orientation[m_.via], f.fold, 0, out);
       break;
     case S::bend_crease: m_.via = 0; break;
-    case S::layer_approach: approach(kLeft, f.fixate_layer, out); break;
-    case S::layer_contact: descend(kLeft, f.fixate_layer, out); break;
-    case S::layer_press: hand_force(kLeft, f.fixate_layer.fingers, f.fixate_layer.force_n, in, out); break;
-    case S::refix_open: hand_posture(kRight, f.open_rad, in, out); break;
-    case S::refix_lift: arm_lift(kRight, f.release_lift_mm, out); break;
-    case S::refix_approach: approach(kRight, f.refixate, out); break;
-    case S::refix_contact: descend(kRight, f.refixate, out); break;
-    case S::refix_press: hand_force(kRight, f.refixate.fingers, f.refixate.force_n, in, out); break;
+    case S::layer_approach: approach(kPinching, f.fixate_layer, out); break;
+    case S::layer_contact: descend(kPinching, f.fixate_layer, out); break;
+    case S::layer_press: hand_force(kPinching, f.fixate_layer.fingers, f.fixate_layer.force_n, in, out); break;
+    case S::refix_open: hand_posture(kFixing, f.open_rad, in, out); break;
+    case S::refix_lift: arm_lift(kFixing, f.release_lift_mm, out); break;
+    case S::refix_approach: approach(kFixing, f.refixate, out); break;
+    case S::refix_contact: descend(kFixing, f.refixate, out); break;
+    case S::refix_press: hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out); break;
     case S::swipe_open:
-    case S::harden_open: hand_posture(kLeft, f.open_rad, in, out); break;
+    case S::harden_open: hand_posture(kPinching, f.open_rad, in, out); break;
     case S::swipe_lift:
-    case S::harden_lift: arm_lift(kLeft, f.release_lift_mm, out); break;
-    case S::swipe_approach: approach(kLeft, f.swipe, out); break;
-    case S::swipe_contact: descend(kLeft, f.swipe, out); break;
-    case S::swipe_press: hand_force(kLeft, f.swipe.fingers, f.swipe.force_n, in, out); break;
+    case S::harden_lift: arm_lift(kPinching, f.release_lift_mm, out); break;
+    case S::swipe_approach: approach(kPinching, f.swipe, out); break;
+    case S::swipe_contact: descend(kPinching, f.swipe, out); break;
+    case S::swipe_press: hand_force(kPinching, f.swipe.fingers, f.swipe.force_n, in, out); break;
     case S::swipe_slide: {
       const double p[3] = {f.swipe_to_mm[0], f.swipe_to_mm[1], -f.slide_height_mm};
-      arm_move(kLeft, f.swipe.tool, ArmGoal::sheet, p, f.swipe.orientation, f.slide, 0, out);
+      arm_move(kPinching, f.swipe.tool, ArmGoal::sheet, p, f.swipe.orientation, f.slide, 0, out);
       break;
     }
     case S::harden_approach: {
@@ -240,20 +271,20 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       ContactStep h = f.harden;
       h.at_mm[0] = m_.harden_a[0];
       h.at_mm[1] = m_.harden_a[1];
-      approach(kLeft, h, out);
+      approach(kPinching, h, out);
       break;
     }
     case S::harden_contact: {
       ContactStep h = f.harden;
       h.at_mm[0] = m_.harden_a[0];
       h.at_mm[1] = m_.harden_a[1];
-      descend(kLeft, h, out);
+      descend(kPinching, h, out);
       break;
     }
-    case S::harden_press: hand_force(kLeft, f.harden.fingers, f.harden.force_n, in, out); break;
+    case S::harden_press: hand_force(kPinching, f.harden.fingers, f.harden.force_n, in, out); break;
     case S::harden_slide: {
       const double p[3] = {m_.harden_b[0], m_.harden_b[1], -f.slide_height_mm};
-      arm_move(kLeft, f.harden.tool, ArmGoal::sheet, p, f.harden.orientation, f.slide, 0, out);
+      arm_move(kPinching, f.harden.tool, ArmGoal::sheet, p, f.harden.orientation, f.slide, 0, out);
       break;
     }
     case S::finish_memorize:
@@ -266,26 +297,26 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::finish_open:
     case S::abort_open:
     case S::abort_reopen:
-      hand_posture(kRight, f.open_rad, in, out);
-      hand_posture(kLeft, f.open_rad, in, out);
+      hand_posture(kFixing, f.open_rad, in, out);
+      hand_posture(kPinching, f.open_rad, in, out);
       break;
     case S::finish_lift:
     case S::abort_lift:
-      arm_lift(kRight, f.release_lift_mm, out);
-      arm_lift(kLeft, f.release_lift_mm, out);
+      arm_lift(kFixing, f.release_lift_mm, out);
+      arm_lift(kPinching, f.release_lift_mm, out);
       break;
     case S::finish_park:
     case S::abort_park:
-      arm_park(kRight, out);
-      arm_park(kLeft, out);
+      arm_park(kFixing, out);
+      arm_park(kPinching, out);
       break;
     case S::abort: ++m_.aborts; break;
     case S::abort_stop:
       // Stop force first (hold the targets), and the arms where they are.
-      hand_hold(kRight, in, out);
-      hand_hold(kLeft, in, out);
-      arm_stop(kRight, out);
-      arm_stop(kLeft, out);
+      hand_hold(kFixing, in, out);
+      hand_hold(kPinching, in, out);
+      arm_stop(kFixing, out);
+      arm_stop(kPinching, out);
       break;
     default: break;
   }

@@ -42,33 +42,32 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
     return h != nullptr && m_.hand_id[s] != 0 && h->goal_id == m_.hand_id[s] && h->mode == HandMode::force &&
            h->settled != 0;
   };
-  auto posed = [&](int s) {
-    const HandControlStatus* h = in.hand[s];
-    if (m_.hand_id[s] == 0) return true;
-    if (h == nullptr) return false;
-    // Refused (in the fold a fault first), or the controller's own retreat: nothing more to wait for.
-    if (h->goals_refused > m_.hand_refused0[s] || h->mode == HandMode::retreat) return true;
-    return h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture && h->max_step_rad <= 1e-6f;
-  };
+  auto posed = [&](int s) { return this->posed(s, in); };
   switch (ev) {
     case Ev::start: return m_.start_pending != 0;
     case Ev::timeout: return timed_out(owner);
     case Ev::fault: return detected_ != Reason::none;
-    case Ev::arm_r_reached: return m_.arm_id[kRight] != 0 && reached(kRight);
-    case Ev::arm_l_reached: return m_.arm_id[kLeft] != 0 && reached(kLeft);
-    case Ev::arms_reached: return reached(kRight) && reached(kLeft);
-    case Ev::arm_r_contact: return contact_stop(kRight);
-    case Ev::arm_l_contact: return contact_stop(kLeft);
-    case Ev::hand_r_settled: return settled(kRight);
-    case Ev::hand_l_settled: return settled(kLeft);
-    case Ev::hand_r_posed: return m_.hand_id[kRight] != 0 && posed(kRight);
-    case Ev::hand_l_posed: return m_.hand_id[kLeft] != 0 && posed(kLeft);
-    case Ev::hands_posed: return posed(kRight) && posed(kLeft);
+    case Ev::arm_fix_reached: return m_.arm_id[kFixing] != 0 && reached(kFixing);
+    case Ev::arm_pin_reached: return m_.arm_id[kPinching] != 0 && reached(kPinching);
+    case Ev::arms_reached: return reached(kFixing) && reached(kPinching);
+    case Ev::arm_fix_contact: return contact_stop(kFixing);
+    case Ev::arm_pin_contact: return contact_stop(kPinching);
+    case Ev::hand_fix_settled: return settled(kFixing);
+    case Ev::hand_pin_settled: return settled(kPinching);
+    case Ev::hand_fix_posed: return m_.hand_id[kFixing] != 0 && posed(kFixing);
+    case Ev::hand_pin_posed: return m_.hand_id[kPinching] != 0 && posed(kPinching);
+    case Ev::hands_posed: return posed(kFixing) && posed(kPinching);
     case Ev::pinched: {
-      const ContactState* c = in.contact[kLeft];
-      const HandControlStatus* h = in.hand[kLeft];
-      return c != nullptr && h != nullptr && h->goal_id == m_.hand_id[kLeft] && c->in_contact != 0 &&
-             (c->fingers & spec_.pinch_fingers) == spec_.pinch_fingers;
+      // The closing ended and every pinching pad measures the squeeze. Not contact_state's
+      // fingers: a finger still following its ramped targets reads as a contact there, with
+      // the corner nowhere between the pads.
+      const HandControlStatus* h = in.hand[kPinching];
+      if (h == nullptr || m_.hand_id[kPinching] == 0 || h->goal_id != m_.hand_id[kPinching] || h->mode != HandMode::posture ||
+          h->max_step_rad > 1e-6f)
+        return false;
+      for (int f = 0; f < HandControlStatus::kFingers; ++f)
+        if ((spec_.pinch_fingers & (1u << f)) != 0 && !(h->force_n[f] >= spec_.pinch_force_n)) return false;
+      return true;
     }
     case Ev::crease_acked: return in.sheet != nullptr && in.sheet->crease_count > m_.crease_count0;
     case Ev::memorized: return in.sheet != nullptr && in.sheet->step >= m_.sheet_step0 + 2;
@@ -81,7 +80,7 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
         if (!hand_ok || moving(in.arm[s])) return false;
       }
       return true;
-    case Ev::arms_done: return ended(in.arm[kRight], m_.arm_id[kRight]) && ended(in.arm[kLeft], m_.arm_id[kLeft]);
+    case Ev::arms_done: return ended(in.arm[kFixing], m_.arm_id[kFixing]) && ended(in.arm[kPinching], m_.arm_id[kPinching]);
     case Ev::always: return true;
   }
   return false;
@@ -97,6 +96,15 @@ double Machine::slide_length(const Sensing& in, double d_sheet[2]) const noexcep
   d_sheet[0] = d[0] * f.x[0] + d[1] * f.x[1] + d[2] * f.x[2];
   d_sheet[1] = d[0] * f.y[0] + d[1] * f.y[1] + d[2] * f.y[2];
   return std::hypot(d[0], d[1]);
+}
+
+bool Machine::posed(int s, const Sensing& in) const noexcept {
+  const HandControlStatus* h = in.hand[s];
+  if (m_.hand_id[s] == 0) return true;
+  if (h == nullptr) return false;
+  // Refused (in the fold a fault first), or the controller's own retreat: nothing more to wait for.
+  if (h->goals_refused > m_.hand_refused0[s] || h->mode == HandMode::retreat) return true;
+  return h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture && h->max_step_rad <= 1e-6f;
 }
 
 bool Machine::passes(Guard g, const Sensing& in) const noexcept {
@@ -125,9 +133,9 @@ bool Machine::passes(Guard g, const Sensing& in) const noexcept {
     }
     case Guard::slide_short: return slide_length(in, d) <= spec_.shift_tolerance_mm;
     case Guard::slide_too_long: return slide_length(in, d) > spec_.max_slide_mm;
-    case Guard::right_armed:
-    case Guard::left_armed: {
-      const ContactState* c = in.contact[g == Guard::right_armed ? kRight : kLeft];
+    case Guard::fixing_armed:
+    case Guard::pinching_armed: {
+      const ContactState* c = in.contact[g == Guard::fixing_armed ? kFixing : kPinching];
       return c != nullptr && c->armed != 0 && c->healthy != 0;
     }
     case Guard::more_via: return m_.via + 1 < spec_.via_count;

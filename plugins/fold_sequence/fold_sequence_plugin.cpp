@@ -16,9 +16,10 @@ void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
   machine_ = std::make_unique<Machine>(spec_);
   outbox_ = std::make_unique<Outbox>();
   ports.tunable("command", &command_, 0.0, 5.0);
+  // Role s (kFixing, kPinching) on the ports of its side.
   const char* side[2] = {"r", "l"};
   for (int s = 0; s < 2; ++s) {
-    const std::string x = side[s];
+    const std::string x = side[s == kPinching ? spec_.pinching_side : 1 - spec_.pinching_side];
     arm_status_[s] = ports.latest_input<ArmMotionStatus>("arm_" + x + "_status");
     hand_status_[s] = ports.latest_input<HandControlStatus>("hand_" + x + "_status");
     contact_[s] = ports.latest_input<ContactState>("contact_" + x + "_state");
@@ -80,7 +81,7 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   status_.write(status_value_, c.time_ns);
   if (status_value_.transitions != logged_transitions_) {
     // Each transition on the report's timeline (the host records a mark as this instance's
-    // event, at the time it was logged, and logs it): "fold/shift/contact: arm_r reached".
+    // event, at the time it was logged, and logs it): "fold/shift/contact: fixing arm contact stop".
     logged_transitions_ = status_value_.transitions;
     char text[96];
     std::size_t n = 0;

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -169,7 +170,12 @@ void read(const Params& p, FoldSpec& f) {
   f.retreat = limits(m, "retreat", MotionLimits{});
 
   const Params h = p.child("hands");
+  const std::string pinching = h.get<std::string>("pinching", "left");
+  if (pinching != "left" && pinching != "right") h.fail("pinching", "must be left or right, not '" + pinching + "'");
+  f.pinching_side = pinching == "right" ? 0 : 1;
   floats(h, "open_rad", kHandJoints, f.open_rad);
+  std::copy(std::begin(f.open_rad), std::end(f.open_rad), std::begin(f.prepinch_rad));
+  floats(h, "prepinch_rad", kHandJoints, f.prepinch_rad);
   floats(h, "pinch_rad", kHandJoints, f.pinch_rad);
   f.posture_ramp_s = h.get_in_range<double>("ramp_s", 0.3, 0.0, 60.0);
   f.force_ramp_s = h.get_in_range<double>("force_ramp_s", 0.1, 0.0, 60.0);
@@ -186,7 +192,22 @@ void read(const Params& p, FoldSpec& f) {
   f.fixate_force_n = b.get_in_range<double>("fixate_force_n", 2.0, 0.0, 10.0);
   f.grasp_tool = tool(b, "tool", 4);
   f.pinch_fingers = fingers(b, "pinch_fingers", 0x11);
+  f.pinch_force_n = b.get_in_range<double>("pinch_force_n", 0.2, 0.01, 10.0);
+  const std::vector<Params> above_via = b.list("above_via");
+  if (above_via.size() > static_cast<std::size_t>(kMaxGraspPath))
+    b.fail("above_via", "expected at most " + std::to_string(kMaxGraspPath) + " points before above_mm");
+  f.grasp_above_via_count = static_cast<int>(above_via.size());
+  for (int i = 0; i < f.grasp_above_via_count; ++i) {
+    const Params& v = above_via[static_cast<std::size_t>(i)];
+    sheet_point(v, "at_mm", f.grasp_above_via_mm[i]);
+    quaternion(v, "orientation", f.grasp_above_via_orientation[i], true);
+  }
   sheet_point(b, "above_mm", f.grasp_above_mm);
+  const std::vector<Params> path = b.list("path");
+  if (path.size() > static_cast<std::size_t>(kMaxGraspPath))
+    b.fail("path", "expected at most " + std::to_string(kMaxGraspPath) + " points before at_mm");
+  f.grasp_path_count = static_cast<int>(path.size());
+  for (int i = 0; i < f.grasp_path_count; ++i) sheet_point(path[static_cast<std::size_t>(i)], "at_mm", f.grasp_path_mm[i]);
   sheet_point(b, "at_mm", f.grasp_at_mm);
   quaternion(b, "orientation", f.grasp_orientation);
 

@@ -17,6 +17,7 @@
 namespace crease::fold {
 
 inline constexpr int kMaxVia = 16;
+inline constexpr int kMaxGraspPath = 7;  // with at_mm, one arm goal's points (ArmGoal::kMaxPoints)
 inline constexpr int kHandJoints = 20;
 inline constexpr int kStates = 64;  // at least the machine's state count (states.h checks it)
 
@@ -58,13 +59,17 @@ struct FoldSpec {
 
   MotionLimits approach, contact, slide, fold, retreat;
 
+  // Which side pinches (0 right, 1 left; the other fixes): the machine's roles (machine.h).
+  int pinching_side = 1;
+
   // Hand postures (20 joints, drivers/README.md's order, rad) and their ramp.
   float open_rad[kHandJoints] = {};
+  float prepinch_rad[kHandJoints] = {};  // shaped for the reach to the corner; open_rad when absent
   float pinch_rad[kHandJoints] = {};
   double posture_ramp_s = 0.3;
   double force_ramp_s = 0.1;       // a force goal's target ramp
 
-  // (a) shift: the right hand presses at shift.at, then slides the sheet so that `corner_mm`
+  // (a) shift: the fixing hand presses at shift.at, then slides the sheet so that `corner_mm`
   // (u, v) moves to `corner_target_mm` (world x, y): the slide's vector from the tracked pose.
   ContactStep shift;
   double corner_mm[2] = {0, 0};
@@ -73,26 +78,34 @@ struct FoldSpec {
   double max_slide_mm = 150;       // a longer slide aborts (reason slide_out_of_range)
   double slide_height_mm = 0;      // the tool frame's height above the sheet while sliding
 
-  // (b) grasp: the right hand fixates with fixate_force_n; the left moves its tool to above_mm,
-  // then to at_mm, then closes to pinch_rad until contact_state shows pinch_fingers.
+  // (b) grasp: the fixing hand fixates with fixate_force_n; the pinching one takes prepinch_rad while its
+  // tool moves (through grasp_above_via) to above_mm, then moves through grasp_path_mm (e.g. round the sheet's edge and up
+  // under its overhang) to at_mm, then closes to pinch_rad until the force controller measures
+  // at least pinch_force_n on every finger of pinch_fingers with the posture's ramp ended.
   double fixate_force_n = 2;
   std::uint8_t grasp_tool = 4;
   std::uint8_t pinch_fingers = 0x11;  // th + ff
+  double pinch_force_n = 0.2;
+  int grasp_above_via_count = 0;   // points the pinching tool passes on its way to above_mm,
+  double grasp_above_via_mm[kMaxGraspPath][3] = {};         // each with its own orientation
+  double grasp_above_via_orientation[kMaxGraspPath][4] = {};  // (a turn the straight path cannot make)
   double grasp_above_mm[3] = {};   // sheet frame
+  int grasp_path_count = 0;
+  double grasp_path_mm[kMaxGraspPath][3] = {};
   double grasp_at_mm[3] = {};
   double grasp_orientation[4] = {0, 0, 0, 1};
 
-  // (c) bend: the left tool through via points (sheet frame of the sheet at each one's start).
+  // (c) bend: the pinching tool through via points (sheet frame of the sheet at each one's start).
   int via_count = 0;
   double via_mm[kMaxVia][3] = {};
   double via_orientation[kMaxVia][4] = {};
 
-  // (d) the left hand's finger backs on the bent layer; (e) the right hand on both layers.
+  // (d) the pinching hand's finger backs on the bent layer; (e) the fixing hand on both layers.
   ContactStep fixate_layer;
   ContactStep refixate;
   double release_lift_mm = 30;     // a hand lifts this far after it opened (e, f, g)
 
-  // (f) the coarse swipe: the left hand lands at swipe.at and slides to swipe_to_mm (u, v).
+  // (f) the coarse swipe: the pinching hand lands at swipe.at and slides to swipe_to_mm (u, v).
   ContactStep swipe;
   double swipe_to_mm[2] = {0, 0};
 

@@ -14,15 +14,15 @@ const char* event_name(Ev e) {
     case Ev::start: return "start";
     case Ev::timeout: return "timeout";
     case Ev::fault: return "fault";
-    case Ev::arm_r_reached: return "arm_r reached";
-    case Ev::arm_l_reached: return "arm_l reached";
+    case Ev::arm_fix_reached: return "fixing arm reached";
+    case Ev::arm_pin_reached: return "pinching arm reached";
     case Ev::arms_reached: return "arms reached";
-    case Ev::arm_r_contact: return "arm_r contact stop";
-    case Ev::arm_l_contact: return "arm_l contact stop";
-    case Ev::hand_r_settled: return "hand_r settled";
-    case Ev::hand_l_settled: return "hand_l settled";
-    case Ev::hand_r_posed: return "hand_r posed";
-    case Ev::hand_l_posed: return "hand_l posed";
+    case Ev::arm_fix_contact: return "fixing arm contact stop";
+    case Ev::arm_pin_contact: return "pinching arm contact stop";
+    case Ev::hand_fix_settled: return "fixing hand settled";
+    case Ev::hand_pin_settled: return "pinching hand settled";
+    case Ev::hand_fix_posed: return "fixing hand posed";
+    case Ev::hand_pin_posed: return "pinching hand posed";
     case Ev::hands_posed: return "hands posed";
     case Ev::pinched: return "pinched";
     case Ev::crease_acked: return "crease in model";
@@ -41,8 +41,8 @@ const char* guard_name(Guard g) {
     case Guard::slide_needed: return "slide needed";
     case Guard::slide_short: return "corner in reach";
     case Guard::slide_too_long: return "slide too long";
-    case Guard::right_armed: return "contact_r armed";
-    case Guard::left_armed: return "contact_l armed";
+    case Guard::fixing_armed: return "fixing contact armed";
+    case Guard::pinching_armed: return "pinching contact armed";
     case Guard::more_via: return "more via";
     case Guard::last_via: return "last via";
   }

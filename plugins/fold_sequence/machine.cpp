@@ -32,6 +32,7 @@ std::uint64_t spec_hash(const FoldSpec& f) noexcept {
   mix(f.name.data(), f.name.size());
   mix(&f.via_count, sizeof f.via_count);
   mix(f.via_mm, sizeof f.via_mm);
+  mix(&f.pinching_side, sizeof f.pinching_side);  // the roles' sides: the memory's goal ids are per side
   return h;
 }
 

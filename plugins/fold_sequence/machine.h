@@ -11,8 +11,10 @@
 // by the operator stops the arms and holds the hands that press; resuming re-enters the state
 // (its commands sent again from where the robot is).
 //
-// Which hand does what is seed 000's (Fig. 7): the right hand (taxels) presses and fixates, the
-// left (PST) pinches, bends, swipes and hardens. Index 0 is the right side, 1 the left.
+// The machine speaks of two roles, not sides: the fixing hand shifts the sheet and fixates it,
+// the pinching hand pinches, bends, swipes and hardens. Seed 000 (Fig. 7) gives the right hand
+// (taxels) the fixing and the left (PST) the pinching; a fold file may swap them (`hands.pinching`)
+// and the plugin binds each role to that side's ports.
 #pragma once
 
 #include <cstdint>
@@ -28,8 +30,8 @@
 
 namespace crease::fold {
 
-inline constexpr int kRight = 0;
-inline constexpr int kLeft = 1;
+inline constexpr int kFixing = 0;    // the role index of Sensing's and Outbox's arrays
+inline constexpr int kPinching = 1;
 
 // One cycle's sensing; a null pointer: never written. Timestamps are compared with now_ns.
 struct Sensing {
@@ -62,7 +64,7 @@ enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, 
 
 struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
-  static constexpr std::uint32_t kVersion = 1;
+  static constexpr std::uint32_t kVersion = 2;  // 2: grasp/shape
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -128,6 +130,8 @@ class Machine {
   // conditions.cpp: events, guards, faults.
   [[nodiscard]] bool holds(Ev ev, S owner, const Sensing& in) const noexcept;
   [[nodiscard]] bool passes(Guard g, const Sensing& in) const noexcept;
+  // The side's last posture goal ramped to its end (or refused, or overridden by a retreat).
+  [[nodiscard]] bool posed(int side, const Sensing& in) const noexcept;
   [[nodiscard]] Reason fault(const Sensing& in) noexcept;  // Reason::none when all is well
   [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2]) const noexcept;
   // actions.cpp: entry and exit actions, the goals.
@@ -136,6 +140,10 @@ class Machine {
   void stop_for_pause(Outbox& out) noexcept;
   void arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                 const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;  // 0: no stop
+  // One motion through the n points of path_mm (1..ArmGoal::kMaxPoints), the tool turned to
+  // orientation[k] at point k.
+  void arm_path(int side, std::uint8_t tool, std::uint8_t frame, int n, const double (*path_mm)[3],
+                const double (*orientation)[4], const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;
   void arm_stop(int side, Outbox& out) noexcept;
   void arm_lift(int side, double lift_mm, Outbox& out) noexcept;
   void arm_park(int side, Outbox& out) noexcept;
@@ -153,7 +161,7 @@ class Machine {
   Reason detected_ = Reason::none;  // the fault found this cycle (the fault row's reason)
 };
 
-// A hash of what a Memory depends on in the fold (its name, via points), for load_state.
+// A hash of what a Memory depends on in the fold (its name, via points, sides), for load_state.
 [[nodiscard]] std::uint64_t spec_hash(const FoldSpec& f) noexcept;
 
 }  // namespace crease::fold

@@ -24,7 +24,7 @@ enum class S : std::uint8_t {
   idle,
   fold,
   shift, shift_approach, shift_contact, shift_press, shift_slide,
-  grasp, grasp_fixate, grasp_above, grasp_reach, grasp_pinch,
+  grasp, grasp_fixate, grasp_shape, grasp_above, grasp_reach, grasp_pinch,
   bend, bend_crease, follow_via,
   fixate_layer, layer_approach, layer_contact, layer_press,
   refixate, refix_open, refix_lift, refix_approach, refix_contact, refix_press,
@@ -44,11 +44,11 @@ enum class Ev : std::uint8_t {
   start,          // the operator's start
   timeout,        // the row's state has been in it longer than its timeout
   fault,          // a fault of the sensing (Reason says which); fold's rows only
-  arm_r_reached, arm_l_reached, arms_reached,   // the state's arm goal(s) reached
-  arm_r_contact, arm_l_contact,                 // stopped on a contact onset
-  hand_r_settled, hand_l_settled,               // force settled on the state's force goal
-  hand_r_posed, hand_l_posed, hands_posed,      // the state's posture goal done
-  pinched,        // the left hand's contact_state shows the pinch fingers
+  arm_fix_reached, arm_pin_reached, arms_reached,   // the state's arm goal(s) reached
+  arm_fix_contact, arm_pin_contact,                 // stopped on a contact onset
+  hand_fix_settled, hand_pin_settled,               // force settled on the state's force goal
+  hand_fix_posed, hand_pin_posed, hands_posed,      // the state's posture goal done
+  pinched,        // the pinching hand's closing ended with the pinch fingers squeezing (force_n)
   crease_acked,   // sheet_state carries one crease more than when the state began
   memorized,      // a sheet_state newer than the memorize request (the model consumed it)
   stopped,        // abort: both hands took the hold goal (or retreat on their own, or refused
@@ -63,8 +63,8 @@ enum class Guard : std::uint8_t {
   slide_needed,   // shift: the corner is further than the tolerance from its target
   slide_short,    // shift: not needed (already there)
   slide_too_long, // shift: longer than max_slide_mm
-  right_armed,    // the hand's contact_state is armed, healthy: a contact motion may start
-  left_armed,
+  fixing_armed,   // the hand's contact_state is armed, healthy: a contact motion may start
+  pinching_armed,
   more_via,       // bend: via points left
   last_via,
 };

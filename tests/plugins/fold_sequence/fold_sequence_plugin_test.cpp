@@ -15,17 +15,16 @@
 
 using namespace rig;
 using crease::fold::Command;
-using crease::fold::kLeft;
-using crease::fold::kRight;
 
 namespace {
 
 const std::vector<std::string> kHalfPath = {
     "idle",
     "fold/shift/approach", "fold/shift/contact", "fold/shift/press", "fold/shift/slide",
-    "fold/grasp/fixate", "fold/grasp/above", "fold/grasp/reach", "fold/grasp/pinch",
+    "fold/grasp/fixate", "fold/grasp/shape", "fold/grasp/above", "fold/grasp/reach", "fold/grasp/pinch",
     "fold/bend/crease", "fold/bend/follow_via[0]", "fold/bend/follow_via[1]", "fold/bend/follow_via[2]",
-    "fold/bend/follow_via[3]", "fold/bend/follow_via[4]",
+    "fold/bend/follow_via[3]", "fold/bend/follow_via[4]", "fold/bend/follow_via[5]", "fold/bend/follow_via[6]",
+    "fold/bend/follow_via[7]",
     "fold/fixate_layer/approach", "fold/fixate_layer/contact", "fold/fixate_layer/press",
     "fold/refixate/open", "fold/refixate/lift", "fold/refixate/approach", "fold/refixate/contact",
     "fold/refixate/press",
@@ -35,6 +34,10 @@ const std::vector<std::string> kHalfPath = {
     "fold/harden/slide",
     "fold/finish/memorize", "fold/finish/open", "fold/finish/lift", "fold/finish/park",
     "done"};
+
+// The half fold's roles (config/folds/half.yaml): the left hand shifts and fixates, the right pinches.
+constexpr int kFix = kLeft;
+constexpr int kPin = kRight;
 
 const std::vector<std::string> kRetreat = {"abort/stop", "abort/open", "abort/lift", "abort/reopen", "abort/park", "aborted"};
 
@@ -108,38 +111,60 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(r.status().phase == SequenceStatus::done);
   CHECK(r.allocations() == 0);
 
-  const auto right = r.all(kRight, Sent::arm);
-  const auto left = r.all(kLeft, Sent::arm);
+  const auto fixing = r.all(kFix, Sent::arm);
+  const auto pinching = r.all(kPin, Sent::arm);
   // No arm is sent on before its motion ended (the robot's motions take move_cycles): each
   // state waited for its motion's status, not for a time of its own.
-  for (const auto* arm : {&right, &left})
+  for (const auto* arm : {&fixing, &pinching})
     for (std::size_t i = 1; i < arm->size(); ++i) CHECK((*arm)[i]->cycle - (*arm)[i - 1]->cycle >= r.move_cycles);
   // (a) approach above the press point, the contact motion, the slide from the tracked pose.
-  REQUIRE(right.size() >= 3);
-  const ArmGoal& ap = right[0]->arm_goal;
+  REQUIRE(fixing.size() >= 3);
+  const ArmGoal& ap = fixing[0]->arm_goal;
   CHECK(ap.frame == ArmGoal::sheet);
   CHECK(ap.tool == 0);  // ff_pad
-  CHECK(ap.position_mm[0][0] == 150.0);
-  CHECK(ap.position_mm[0][1] == 90.0);
+  CHECK(ap.position_mm[0][0] == 165.0);
+  CHECK(ap.position_mm[0][1] == 88.5);
   CHECK(ap.position_mm[0][2] == -30.0);  // 30 mm above the sheet: the sheet frame's z points down
   CHECK(ap.stop_on == ArmGoal::stop_none);
-  const ArmGoal& ct = right[1]->arm_goal;
+  const ArmGoal& ct = fixing[1]->arm_goal;
   CHECK(ct.stop_on == ArmGoal::contact_onset);
   CHECK(ct.stop_fingers == 0x03);  // ff, mf
   CHECK(ct.position_mm[0][2] == 5.0);
-  // The corner (0, 297) lies at world (-105, -148.5); its target (-130, -195): a slide of
-  // (-25, -46.5) mm in the world, (-25, +46.5) along the sheet's u and v (v runs along -y).
-  const ArmGoal& sl = right[2]->arm_goal;
-  CHECK(near(sl.position_mm[0][0], 125.0));
-  CHECK(near(sl.position_mm[0][1], 136.5));
+  // The far edge's middle (105, 297) lies at world (-25, 127); its target (0, 148.5): a slide of
+  // (25, 21.5) mm in the world, (-25, +21.5) along the turned sheet's u and v.
+  const ArmGoal& sl = fixing[2]->arm_goal;
+  CHECK(near(sl.position_mm[0][0], 140.0));
+  CHECK(near(sl.position_mm[0][1], 110.0));
   CHECK(sl.speed_mm_s == 30.0f);
   // The press, then the fixation force.
-  const auto rh = r.all(kRight, Sent::hand);
-  REQUIRE(rh.size() >= 3);
-  CHECK(rh[1]->hand_goal.mode == HandMode::force);
-  CHECK(rh[1]->hand_goal.force_n == 1.5f);
-  CHECK(rh[1]->hand_goal.fingers == 0x03);
-  CHECK(rh[2]->hand_goal.force_n == 2.0f);
+  const auto fh = r.all(kFix, Sent::hand);
+  REQUIRE(fh.size() >= 3);
+  CHECK(fh[1]->hand_goal.mode == HandMode::force);
+  CHECK(fh[1]->hand_goal.force_n == 1.5f);
+  CHECK(fh[1]->hand_goal.fingers == 0x03);
+  CHECK(fh[2]->hand_goal.force_n == 2.0f);
+  // (b) the pinching hand shaped, then its arm above the edge, then one motion round the overhang
+  // to the pinch (the file's path and at_mm), then the closing.
+  const auto ph = r.all(kPin, Sent::hand);
+  REQUIRE(ph.size() >= 3);
+  CHECK(ph[1]->hand_goal.mode == HandMode::posture);
+  CHECK(ph[1]->hand_goal.target_rad[3] == doctest::Approx(1.428));  // FFJ3 curled
+  CHECK(ph[1]->hand_goal.target_rad[15] == doctest::Approx(0.0));   // THJ5 open
+  CHECK(ph[2]->hand_goal.target_rad[15] == doctest::Approx(0.77));  // THJ5 closed
+  REQUIRE(pinching.size() >= 2);
+  CHECK(pinching[0]->cycle >= ph[1]->cycle + r.posture_cycles);  // shaped before its arm moves
+  const ArmGoal& to_above = pinching[0]->arm_goal;
+  REQUIRE(to_above.point_count == 2);  // through above_via, its own orientation
+  CHECK(near(to_above.position_mm[0][2], -300.0));
+  CHECK(near(to_above.orientation[0][1], -0.85576));
+  CHECK(near(to_above.orientation[1][0], -0.64086));
+  const ArmGoal& reach = pinching[1]->arm_goal;
+  REQUIRE(reach.point_count == 3);
+  CHECK(near(reach.position_mm[0][2], 35.5));
+  CHECK(near(reach.position_mm[1][1], 282.5));
+  CHECK(near(reach.position_mm[2][2], 1.7));
+  CHECK(near(reach.orientation[2][0], -0.64086));
+  CHECK(ph[2]->cycle > pinching[1]->cycle);
   // (c) the crease the fold intends goes to the model before the first via point, once.
   long crease_cycle = -1;
   int creases = 0;
@@ -154,21 +179,23 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
       CHECK(s.crease_event.b_mm[1] == 148.5f);
     }
   CHECK(creases == 1);
-  // The left arm: above the corner, at it, then the five via points in order, in the sheet frame.
-  REQUIRE(left.size() >= 7);
-  const double via[5][3] = {{-5, 257.0, -108.5}, {-5, 148.5, -153.5}, {-5, 40.0, -108.5}, {-5, 0.2, -39.7}, {-5, -4.9, -5.4}};
-  for (int k = 0; k < 5; ++k) {
+  // The pinching arm: above the edge, round it to the pinch, then the eight via points in order,
+  // in the sheet frame.
+  REQUIRE(pinching.size() >= 10);
+  const double via[8][3] = {{105, 282.5, -20.0}, {105, 255.8, -60.3}, {105, 206.8, -99.3}, {105, 148.5, -112.2},
+                            {105, 90.2, -99.3},  {105, 41.2, -60.3},  {105, 24.1, -31.6}, {105, 14.5, -20.0}};
+  for (int k = 0; k < 8; ++k) {
     CAPTURE(k);
-    const ArmGoal& g = left[2 + static_cast<std::size_t>(k)]->arm_goal;
-    CHECK(left[2 + static_cast<std::size_t>(k)]->cycle > crease_cycle);
+    const ArmGoal& g = pinching[2 + static_cast<std::size_t>(k)]->arm_goal;
+    CHECK(pinching[2 + static_cast<std::size_t>(k)]->cycle > crease_cycle);
     CHECK(g.frame == ArmGoal::sheet);
     for (int c = 0; c < 3; ++c) CHECK(near(g.position_mm[0][c], via[k][c]));
     CHECK(g.speed_mm_s == 40.0f);
   }
-  CHECK(near(left[3]->arm_goal.orientation[0][0], -0.49265));  // the pinched pad turned 90 deg about -u
+  CHECK(near(pinching[5]->arm_goal.orientation[0][0], -0.52423));  // the pinch turned 90 deg with the sheet
   // (g) the hardening stroke along the model's crease, inset 10 mm, 4 mm onto the stack.
   const Sent* hs = nullptr;
-  for (const Sent* s : left)
+  for (const Sent* s : pinching)
     if (s->arm_goal.stop_on == ArmGoal::contact_onset && s->arm_goal.position_mm[0][1] < 146) hs = s;
   REQUIRE(hs != nullptr);
   CHECK(near(hs->arm_goal.position_mm[0][0], 10.0));
@@ -200,7 +227,7 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
 }
 
 TEST_CASE("the diagonal fold runs from its file alone: its crease, its via points") {
-  Rig r(fold_file("diagonal.yaml"));
+  Rig r(fold_file("diagonal.yaml"), false);
   r.command(Command::start);
   REQUIRE(r.run_to("done"));
   CHECK(r.allocations() == 0);
@@ -224,7 +251,7 @@ TEST_CASE("success comes from sensing: a motion that never ends holds its state 
   // Failing variant first: the motion reached, the state moves on within its motion's cycles.
   start_and_run_to(r, "fold/shift/contact");
   Rig s;
-  s.stalls = [](int side, const ArmGoal&, int index) { return side == kRight && index == 0; };
+  s.stalls = [](int side, const ArmGoal&, int index) { return side == kFix && index == 0; };
   s.command(Command::start);
   REQUIRE(s.run_to("fold/shift/approach"));
   s.run(5000);  // 5 s of cycles: far beyond the 20 motion cycles, well inside the 20 s timeout
@@ -235,42 +262,55 @@ TEST_CASE("success comes from sensing: a motion that never ends holds its state 
   CHECK(s.cycles() < 30000);
 }
 
+TEST_CASE("the pinch is felt: a closing whose pads squeeze nothing holds grasp/pinch until its timeout") {
+  // Failing variant first: the pads measure 0.5 N each, over pinch_force_n (0.2 N): the bend starts.
+  Rig r;
+  start_and_run_to(r, "fold/bend/crease");
+  Rig s;
+  s.pinch_feels = false;  // contact_state names th and ff all the same
+  s.command(Command::start);
+  REQUIRE(s.run_to("fold/grasp/pinch"));
+  s.run(5000);
+  CHECK(std::string(s.status().path) == "fold/grasp/pinch");
+  expect_abort(s, crease::fold::Reason::timeout);
+}
+
 TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {
   using crease::fold::Reason;
   SUBCASE("device fault: the arm's drive faults during a motion") {
     Rig r;
     start_and_run_to(r, "fold/grasp/above");
-    r.arm_fault[kLeft] = true;
+    r.arm_fault[kPin] = true;
     expect_abort(r, Reason::device_fault);
   }
   SUBCASE("device fault: the hand's force controller inhibits (hand_state fault)") {
     Rig r;
     start_and_run_to(r, "fold/shift/press");
-    r.inhibit[kRight] = HandInhibit::hand_state_fault;
+    r.inhibit[kFix] = HandInhibit::hand_state_fault;
     expect_abort(r, Reason::device_fault);
   }
   SUBCASE("device fault: the hand's inputs go bad and it refuses every goal: the retreat goes on") {
     Rig r;
     start_and_run_to(r, "fold/grasp/fixate");
-    r.inhibit[kRight] = HandInhibit::hand_state_fault;
-    r.refuse_hand_goals[kRight] = true;
+    r.inhibit[kFix] = HandInhibit::hand_state_fault;
+    r.refuse_hand_goals[kFix] = true;
     REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }));
     const long c0 = r.cycles();
     REQUIRE(r.run_to("aborted"));
     CHECK(r.cycles() - c0 < 1000);  // not the open step's 20 s timeout: a refused goal ends it
     CHECK(r.status().abort_reason == static_cast<std::uint8_t>(Reason::device_fault));
-    CHECK(r.last(kLeft, Sent::hand)->hand_goal.mode == HandMode::posture);  // the other hand opened
+    CHECK(r.last(kPin, Sent::hand)->hand_goal.mode == HandMode::posture);  // the other hand opened
   }
   SUBCASE("force limit") {
     Rig r;
     start_and_run_to(r, "fold/refixate/press");
-    r.inhibit[kRight] = HandInhibit::force_limit;
+    r.inhibit[kFix] = HandInhibit::force_limit;
     expect_abort(r, Reason::force_limit);
   }
   SUBCASE("unreachable via point") {
     Rig r;
     // The left arm's goals: above, at the corner, then via 0, 1, 2: the third via is refused.
-    r.unreachable = [](int side, const ArmGoal&, int index) { return side == kLeft && index == 4; };
+    r.unreachable = [](int side, const ArmGoal&, int index) { return side == kPin && index == 4; };
     r.command(Command::start);
     REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }));
     CHECK(r.paths()[r.paths().size() - 2] == "fold/bend/follow_via[2]");
@@ -293,7 +333,7 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
   }
   SUBCASE("a slide longer than the file allows") {
     Rig r;
-    r.place_sheet(-105 + 200, 148.5);  // the corner 200 mm off its target
+    r.place_sheet(80 - 200, -170, true);  // the corner 200 mm further off its target
     start_and_run_to(r, "fold/shift/press");
     expect_abort(r, Reason::slide_out_of_range);
   }
@@ -302,7 +342,7 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
     start_and_run_to(r, "fold/shift/approach");  // the approach goal taken this cycle
     r.run(r.move_cycles - 1);
     CHECK(std::string(r.status().path) == "fold/shift/approach");
-    r.inhibit[kRight] = HandInhibit::tactile_stale;  // seen in the cycle the approach is reached
+    r.inhibit[kFix] = HandInhibit::tactile_stale;  // seen in the cycle the approach is reached
     r.cycle();
     CHECK(std::string(r.status().path) == "abort/stop");
     CHECK(std::find(r.paths().begin(), r.paths().end(), "fold/shift/contact") == r.paths().end());
@@ -318,7 +358,7 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
 }
 
 // Opening a hand pressed on the sheet can drive a fingertip over its force limit: the force
-// controller retreats and refuses goals while it reads over it (here: the right hand refuses
+// controller retreats and refuses goals while it reads over it (here: the pinching hand refuses
 // from the abort's open on). Once lifted it takes goals again, and the abort opens it again
 // before the park (abort/reopen), so the park is not refused behind the hand's retreat
 // (config.sim_sequence: without the reopen the hand stays at the retreat's 0.15 rad and the
@@ -331,19 +371,19 @@ TEST_CASE("the abort opens the hands again once lifted, before the park") {
     start_and_run_to(r, "fold/shift/press");
     r.command(Command::abort);
     REQUIRE(r.run_to("abort/open"));
-    r.refuse_hand_goals[kRight] = true;
+    r.refuse_hand_goals[kFix] = true;
     REQUIRE(r.run_to("abort/lift"));
     const long lifted_from = r.cycles();
-    r.refuse_hand_goals[kRight] = still_over;
+    r.refuse_hand_goals[kFix] = still_over;
     REQUIRE(r.run_to("abort/reopen"));
     const long reopen_at = r.cycles();
     REQUIRE(r.run_to("aborted"));
     CHECK(r.cycles() - reopen_at < 1000);
-    const auto lifts = r.all(kRight, Sent::arm, lifted_from);
+    const auto lifts = r.all(kFix, Sent::arm, lifted_from);
     REQUIRE(lifts.size() == 2);  // the lift, then the park
     CHECK(lifts[0]->arm_goal.frame == ArmGoal::measured);
     CHECK(lifts[1]->arm_goal.frame == ArmGoal::world);
-    const auto opens = r.all(kRight, Sent::hand, lifted_from);
+    const auto opens = r.all(kFix, Sent::hand, lifted_from);
     REQUIRE(opens.size() == 1);  // the reopen's, after the lift and before the park
     CHECK(opens[0]->cycle > lifts[0]->cycle);
     CHECK(opens[0]->cycle < lifts[1]->cycle);
@@ -363,7 +403,7 @@ TEST_CASE("the start waits until the controllers answer and the sheet is seen") 
   r.observations = 12;
   REQUIRE(r.run_to("fold/shift/approach", 1000));
   CHECK(std::string(r.status().why) == "start");
-  r.inhibit[kLeft] = HandInhibit::hand_state_stale;
+  r.inhibit[kPin] = HandInhibit::hand_state_stale;
   expect_abort(r, crease::fold::Reason::device_fault);
   // A start after the abort: the inhibit the controller latched (until its next goal) is not
   // the new fold's fault; the sheet lost is the guard's business again.
@@ -380,8 +420,8 @@ TEST_CASE("the start waits until the controllers answer and the sheet is seen") 
 
 TEST_CASE("the shift's guard: a corner already in reach skips the slide") {
   Rig r;
-  // Corner (0, 297) placed on its target (-130, -195): corner (0, 0) at (-130, 102).
-  r.place_sheet(-130, -195 + 297);
+  // Corner (105, 297) placed on its target (0, 148.5): corner (0, 0) at (105, -148.5).
+  r.place_sheet(105, -148.5, true);
   r.command(Command::start);
   REQUIRE(r.run_to("fold/grasp/fixate"));
   CHECK(std::find(r.paths().begin(), r.paths().end(), "fold/shift/slide") == r.paths().end());
@@ -393,12 +433,12 @@ TEST_CASE("pause stops the arms and holds; resume sends the state's goal again; 
   start_and_run_to(r, "fold/bend/follow_via[1]");
   r.move_cycles = 200;
   r.run(5);
-  const auto before = r.all(kLeft, Sent::arm).size();
+  const auto before = r.all(kPin, Sent::arm).size();
   const long paused_at = r.cycles();
   r.command(Command::pause);
   r.run(1);
   CHECK(r.status().phase == SequenceStatus::paused);
-  const auto stops = r.all(kLeft, Sent::arm, paused_at);
+  const auto stops = r.all(kPin, Sent::arm, paused_at);
   REQUIRE(stops.size() == 1);
   CHECK(stops[0]->arm_goal.kind == ArmGoal::stop);
   const double t0 = r.status().time_in_state_s;
@@ -407,12 +447,12 @@ TEST_CASE("pause stops the arms and holds; resume sends the state's goal again; 
   CHECK(r.status().time_in_state_s == t0);
   r.command(Command::resume);
   r.run(1);
-  const auto again = r.all(kLeft, Sent::arm, paused_at + 2);
+  const auto again = r.all(kPin, Sent::arm, paused_at + 2);
   REQUIRE(again.size() == 1);
-  CHECK(near(again[0]->arm_goal.position_mm[0][1], 148.5));  // via 1 again
-  CHECK(r.all(kLeft, Sent::arm).size() == before + 2);
-  // The right hand fixating the sheet was held by the pause and presses again.
-  const auto held = r.all(kRight, Sent::hand, paused_at);
+  CHECK(near(again[0]->arm_goal.position_mm[0][1], 255.8));  // via 1 again
+  CHECK(r.all(kPin, Sent::arm).size() == before + 2);
+  // The hand fixating the sheet was held by the pause and presses again.
+  const auto held = r.all(kFix, Sent::hand, paused_at);
   REQUIRE(held.size() == 2);
   CHECK(held[0]->hand_goal.mode == HandMode::hold);
   CHECK(held[1]->hand_goal.mode == HandMode::force);

@@ -56,18 +56,31 @@ std::string error_of(const std::string& path) {
 TEST_CASE("the shipped folds load") {
   const FoldSpec h = load_fold_file(shipped("half.yaml"));
   CHECK(h.name == "half");
-  CHECK(h.via_count == 5);
+  CHECK(h.via_count == 8);
   CHECK(h.fold_line_mm[0][1] == 148.5);
-  CHECK(h.via_mm[1][2] == -153.5);  // [u, v, h]: h above the sheet is the sheet frame's -z
+  CHECK(h.via_mm[1][2] == -60.3);  // [u, v, h]: h above the sheet is the sheet frame's -z
   CHECK(h.shift.fingers == 0x03);
   CHECK(h.fixate_layer.tool == 5);  // ff_back
   CHECK(h.pinch_fingers == 0x11);
+  CHECK(h.pinching_side == 0);      // the right hand pinches
+  CHECK(h.pinch_force_n == 0.2);
+  CHECK(h.prepinch_rad[3] == doctest::Approx(1.428));
+  CHECK(h.pinch_rad[15] == doctest::Approx(0.77));  // THJ5 closed
+  REQUIRE(h.grasp_above_via_count == 1);
+  CHECK(h.grasp_above_via_mm[0][2] == -300.0);
+  CHECK(h.grasp_above_via_orientation[0][1] == -0.85576);
+  REQUIRE(h.grasp_path_count == 2);
+  CHECK(h.grasp_path_mm[1][1] == 282.5);
+  CHECK(h.grasp_path_mm[1][2] == 35.5);  // 35.5 mm under the sheet: +z
   CHECK(h.timeout_s[static_cast<std::size_t>(S::follow_via)] == 15.0);
   CHECK(h.timeout_s[static_cast<std::size_t>(S::shift_approach)] == 20.0);
   CHECK(h.timeout_s[static_cast<std::size_t>(S::shift)] == 120.0);
   CHECK(h.timeout_s[static_cast<std::size_t>(S::idle)] == 0.0);
   const FoldSpec d = load_fold_file(shipped("diagonal.yaml"));
   CHECK(d.name == "diagonal");
+  CHECK(d.pinching_side == 1);  // absent: seed 000's left hand
+  CHECK(d.grasp_path_count == 0);
+  for (int j = 0; j < kHandJoints; ++j) CHECK(d.prepinch_rad[j] == d.open_rad[j]);  // absent: open
   CHECK(d.fold_line_mm[1][0] == 210.0);
   CHECK(d.via_count == 5);
 }
@@ -76,7 +89,7 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
   const std::string tmp = (std::filesystem::temp_directory_path() / "crease_fold_spec_test.yaml").string();
   SUBCASE("a missing file") { CHECK(error_of("/nonexistent/fold.yaml").find("/nonexistent/fold.yaml") == 0); }
   SUBCASE("YAML that does not parse") {
-    const std::string e = error_of(variant("  at_mm: [150, 90]", "  at_mm: [150, 90"));
+    const std::string e = error_of(variant("  at_mm: [165, 88.5]", "  at_mm: [165, 88.5"));
     CHECK(e.find(tmp + ":") == 0);
     CHECK(e.find("fold") != std::string::npos);
   }
@@ -87,7 +100,7 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(e.find("fold.shift.forse_n: unknown key") != std::string::npos);
   }
   SUBCASE("a missing required key") {
-    const std::string e = error_of(variant("  corner_mm: [0, 297]", ""));
+    const std::string e = error_of(variant("  corner_mm: [105, 297]", ""));
     CHECK(e.find("fold.shift.corner_mm: required") != std::string::npos);
   }
   SUBCASE("an unknown tool frame") {
@@ -101,13 +114,13 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(e.find("fold.grasp.pinch_fingers: unknown finger 'xx'") != std::string::npos);
   }
   SUBCASE("a via point that is not three numbers") {
-    const int line = line_of("[-5, 148.5, 153.5]");
-    const std::string e = error_of(variant("[-5, 148.5, 153.5]", "[-5, 148.5]"));
+    const int line = line_of("[105, 255.8, 60.3]");
+    const std::string e = error_of(variant("[105, 255.8, 60.3]", "[105, 255.8]"));
     CHECK(e.find(tmp + ":" + std::to_string(line) + ":") == 0);
     CHECK(e.find("fold.bend.via[1].at_mm: expected a list of 3 numbers") != std::string::npos);
   }
   SUBCASE("a quaternion off unit length") {
-    const std::string e = error_of(variant("[-0.49265, -0.50725, 0.50725, 0.49265]", "[-0.7, 0, 0, 0.9]"));
+    const std::string e = error_of(variant("[-0.64504, 0.75289, 0.11116, -0.06877]", "[-0.7, 0, 0, 0.9]"));
     CHECK(e.find("fold.bend.via[1].orientation: must be a unit quaternion") != std::string::npos);
   }
   SUBCASE("a timeout of a state that does not exist") {
@@ -122,6 +135,35 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     const std::string e =
         error_of(variant("approach: {speed_mm_s: 80, accel_mm_s2: 400", "approach: {speed_mm_s: 80, accel_mm_s2: 4000"));
     CHECK(e.find("fold.motion.approach.stop_accel_mm_s2: must be at least accel_mm_s2") != std::string::npos);
+  }
+  SUBCASE("a pinching hand that is no side") {
+    const int line = line_of("  pinching: right");
+    const std::string e = error_of(variant("  pinching: right", "  pinching: both"));
+    CHECK(e.find(tmp + ":" + std::to_string(line) + ":") == 0);
+    CHECK(e.find("fold.hands.pinching: must be left or right, not 'both'") != std::string::npos);
+  }
+  SUBCASE("a pinch force out of range") {
+    const std::string e = error_of(variant("  pinch_force_n: 0.2", "  pinch_force_n: 0"));
+    CHECK(e.find("fold.grasp.pinch_force_n: must be in [0.01, 10], got 0") != std::string::npos);
+  }
+  SUBCASE("a grasp path longer than one arm goal holds") {
+    std::string path = "  path:\n";
+    for (int i = 0; i < 8; ++i) path += "    - {at_mm: [105, 338.5, -35.5]}\n";
+    const std::string e = error_of(variant("  path:\n    - {at_mm: [105, 338.5, -35.5]}\n", path));
+    CHECK(e.find("fold.grasp.path: expected at most 7 points before at_mm") != std::string::npos);
+  }
+  SUBCASE("a grasp path point that is not three numbers") {
+    const std::string e = error_of(variant("    - {at_mm: [105, 282.5, -35.5]}", "    - {at_mm: [105, 282.5]}"));
+    CHECK(e.find("fold.grasp.path[1].at_mm: expected a list of 3 numbers") != std::string::npos);
+  }
+  SUBCASE("an above_via point without its orientation") {
+    const std::string e =
+        error_of(variant(", orientation: [0.08625, -0.85576, 0.05114, 0.50756]}", "}"));
+    CHECK(e.find("fold.grasp.above_via[0].orientation: required") != std::string::npos);
+  }
+  SUBCASE("a prepinch posture of the wrong length") {
+    const std::string e = error_of(variant("  prepinch_rad: [0, 0,", "  prepinch_rad: [0,"));
+    CHECK(e.find("fold.hands.prepinch_rad: expected a list of 20 numbers") != std::string::npos);
   }
   SUBCASE("a degenerate fold line") {
     const std::string e = error_of(variant("[[0, 148.5], [210, 148.5]]", "[[0, 148.5], [0.5, 148.5]]"));

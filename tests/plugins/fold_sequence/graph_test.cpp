@@ -28,9 +28,9 @@ TEST_CASE("every state and row is in the graph") {
   CHECK(count(g, "[style=dashed]") == supers);  // the initial children
   const RowSpan rows = all_rows();
   CHECK(count(g, " -> ") == static_cast<int>(rows.end - rows.begin) + supers);
-  CHECK(g.find("follow_via[0..4]") != std::string::npos);
+  CHECK(g.find("follow_via[0..7]") != std::string::npos);
   CHECK(g.find("s_fold_anchor -> s_abort_anchor [label=\"fault\", ltail=cluster_s_fold, lhead=cluster_s_abort, color=red]") !=
         std::string::npos);
-  CHECK(g.find("arm_l reached [more via]") != std::string::npos);
+  CHECK(g.find("pinching arm reached [more via]") != std::string::npos);
   CHECK(count(graphviz(), "\\n") == 0);  // without a fold: no timeouts
 }

@@ -72,13 +72,13 @@ TEST_CASE("a command the plugin could not queue aborts the fold with command_los
   m.fill_status(st, 1'000'000);
   CHECK(std::string(st.path) == "fold/shift/approach");
   CHECK(std::string(st.why) == "start");
-  CHECK(out.arm_count[kRight] == 1);
-  CHECK(out.hand_count[kRight] == 1);
-  CHECK(out.hand_count[kLeft] == 1);
+  CHECK(out.arm_count[kFixing] == 1);
+  CHECK(out.hand_count[kFixing] == 1);
+  CHECK(out.hand_count[kPinching] == 1);
   m.step(q.at(2'000'000), out);  // nothing finished: it waits
   m.fill_status(st, 2'000'000);
   CHECK(std::string(st.path) == "fold/shift/approach");
-  CHECK(out.arm_count[kRight] == 0);
+  CHECK(out.arm_count[kFixing] == 0);
   m.fail(Reason::command_lost);
   m.step(q.at(3'000'000), out);
   m.fill_status(st, 3'000'000);
@@ -87,10 +87,10 @@ TEST_CASE("a command the plugin could not queue aborts the fold with command_los
   CHECK(st.abort_reason == static_cast<std::uint8_t>(Reason::command_lost));
   CHECK(st.phase == SequenceStatus::aborted);
   // The retreat's first goals: hold to both hands, stop to both arms.
-  CHECK(out.hand[kRight][0].mode == HandMode::hold);
-  CHECK(out.hand[kLeft][0].mode == HandMode::hold);
-  CHECK(out.arm[kRight][0].kind == ArmGoal::stop);
-  CHECK(out.arm[kLeft][0].kind == ArmGoal::stop);
+  CHECK(out.hand[kFixing][0].mode == HandMode::hold);
+  CHECK(out.hand[kPinching][0].mode == HandMode::hold);
+  CHECK(out.arm[kFixing][0].kind == ArmGoal::stop);
+  CHECK(out.arm[kPinching][0].kind == ArmGoal::stop);
 }
 
 TEST_CASE("outside the fold, pause, resume and abort do nothing; start only from a resting state") {

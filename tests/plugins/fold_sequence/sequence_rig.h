@@ -28,6 +28,10 @@ namespace rig {
 using namespace crease;
 using crease::fold::FoldSequencePlugin;
 
+// The rig's sides: its ports in the plugin's order (arm_r_..., arm_l_...), whichever role each has.
+inline constexpr int kRight = 0;
+inline constexpr int kLeft = 1;
+
 inline std::string fold_file(const char* name) { return std::string(CREASE_SOURCE_DIR) + "/config/folds/" + name; }
 
 // One goal the robot took, in order.
@@ -42,7 +46,11 @@ struct Sent {
 
 class Rig {
  public:
-  explicit Rig(const std::string& fold = fold_file("half.yaml")) : fold_(fold), sheet_(std::make_unique<SheetState>()) {
+  // TURNED: the sheet as the simulated robot lays it for the half fold (config/sim.yaml), 25 mm
+  // and 21.5 mm short of where its shift puts it; else as it lay before, corner (0, 0) at
+  // (-105, 148.5), u along +x.
+  explicit Rig(const std::string& fold = fold_file("half.yaml"), bool turned = true)
+      : fold_(fold), sheet_(std::make_unique<SheetState>()) {
     plugin_ = make_plugin();
     for (int s = 0; s < 2; ++s) {
       const std::string x = s == 0 ? "r" : "l";
@@ -56,7 +64,11 @@ class Rig {
     memorize_in_ = rig_ports_.queue_input<SheetMemorizeEvent>("sheet_memorize");
     sheet_out_ = rig_ports_.latest_output<SheetState>("sheet_state", *sheet_);
     status_in_ = rig_ports_.latest_input<SequenceStatus>("sequence_status");
-    place_sheet(-105, 148.5);
+    if (turned) {
+      place_sheet(80, -170, true);
+    } else {
+      place_sheet(-105, 148.5, false);
+    }
     for (int s = 0; s < 2; ++s) {
       contact_[s].armed = 1;
       contact_[s].healthy = 1;
@@ -83,8 +95,10 @@ class Rig {
       if (t.key == "command") *t.target = static_cast<double>(c);
   }
 
-  // The flat sheet, 3 x 3 nodes, corner (0, 0) at world (x0, y0), u along +x, v along -y.
-  void place_sheet(double x0, double y0) {
+  // The flat sheet, 3 x 3 nodes, corner (0, 0) at world (x0, y0), u along +x, v along -y
+  // (TURNED: u along -x, v along +y).
+  void place_sheet(double x0, double y0, bool turned) {
+    const double sign = turned ? -1.0 : 1.0;
     SheetState& s = *sheet_;
     s.nodes_u = 3;
     s.nodes_v = 3;
@@ -93,8 +107,8 @@ class Rig {
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) {
         float* p = s.position_mm[j * 3 + i];
-        p[0] = static_cast<float>(x0 + 105.0 * i);
-        p[1] = static_cast<float>(y0 - 148.5 * j);
+        p[0] = static_cast<float>(x0 + sign * 105.0 * i);
+        p[1] = static_cast<float>(y0 - sign * 148.5 * j);
         p[2] = 0;
         s.normal[j * 3 + i][2] = -1;
       }
@@ -166,6 +180,9 @@ class Rig {
   HandInhibit inhibit[2] = {HandInhibit::none, HandInhibit::none};
   bool arm_fault[2] = {false, false};  // the running motion aborts with arm_fault
   bool refuse_hand_goals[2] = {false, false};  // every hand goal refused (inputs bad)
+  // The pinch posture ends with th and ff squeezing (0.5 N each); false: the pads close on
+  // nothing, though contact_state still names both (as a lagging ramp makes it do).
+  bool pinch_feels = true;
 
  private:
   struct Arm {
@@ -210,7 +227,9 @@ class Rig {
           if (h.pinch) {
             contact_[s].in_contact = 1;
             contact_[s].fingers = 0x11;
+            if (pinch_feels) h.st.force_n[0] = h.st.force_n[4] = 0.5f;  // th and ff squeeze the corner
           } else {
+            for (float& f : h.st.force_n) f = 0;
             contact_[s].in_contact = 0;
             contact_[s].fingers = 0;
           }

@@ -15,7 +15,9 @@
 // robot (the near edge over to the far one) the turning hand's wrist moves away from the
 // shoulder and the elbow straightens too.)
 // Failing variants: frictionless fingers: the pinch loses the edge at ~60 deg and it falls back;
-// the left index not pressing: the pinch drags the near half after it.
+// the left index not pressing: the pinch drags the near half after it. And the grasp of
+// config/folds/half.yaml: from beyond the far edge, round its drooping overhang (failing variant:
+// straight in at the pinch's height, into the hanging edge).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -139,18 +141,33 @@ double near_edge_y(const World& w) {
   return y / g.w;
 }
 
+// How the pinching hand gets to the pinch. The default: it starts there, the index pad 8 mm under
+// the overhang (53.5 mm over the table's edge at y = 95). FROM_BEYOND (config/folds/half.yaml's
+// grasp): the table's edge at y = 115 (33.5 mm of overhang, drooping ~20 mm), the hand starts 40 mm
+// over the table beyond the far edge, the thumb open at THJ5 OPEN_THJ5, and goes round the
+// overhang: down to UNDER_MM under the table top, in under the sheet, then up to the pinch.
+struct Grasp {
+  bool from_beyond = false;
+  double table_edge_y_mm = 95.0;
+  double open_thj5 = 0.3;
+  double under_mm = 8.0;
+};
+
+Grasp from_beyond(double under_mm) { return {true, 115.0, 0.0, under_mm}; }
+
 // FIXATE false: the left index hovers 8 mm over the near half instead of pressing it.
-Fold fold(WorldParams p, Bimanual& b, bool fixate = true) {
+Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {}) {
   REQUIRE(p.table_height_mm == kTableMm);
   REQUIRE(p.sheet.grid.origin_mm.y == 148.5 + kSheetDyMm);
-  p.table_extent_mm = {-WorldParams::kNoEdge, WorldParams::kNoEdge, -WorldParams::kNoEdge, 95.0 + kSheetDyMm};
+  p.table_extent_mm = {-WorldParams::kNoEdge, WorldParams::kNoEdge, -WorldParams::kNoEdge,
+                       grasp.table_edge_y_mm + kSheetDyMm};
   b.params = p;
   // The pinch (reference_poses.h) turned about z to reach the far edge from beyond it, the index
-  // pad 8 mm under the overhang, 14.5 mm inside the far edge's middle; 3 N m/rad.
+  // pad under the overhang, 14.5 mm inside the far edge's middle; 3 N m/rad.
   const Vec3 at{0, 134.0 + kSheetDyMm, kTableMm - 8};
-  b.r.q = poses::pinch_hand(0.3);
+  b.r.q = poses::pinch_hand(grasp.open_thj5);
   b.r.palm = KDL::Rotation::RotZ(std::numbers::pi) * poses::pinch_palm(robot_model(), poses::pinch_hand(0.696));
-  b.r.at = at;
+  b.r.at = grasp.from_beyond ? Vec3{at.x, 190.0 + kSheetDyMm, kTableMm + 40} : at;
   b.r.k.fill(3.0);
   // The left index over the near half, 60 mm from its left and 60 mm from the crease; 3 N m/rad.
   b.l.q = poses::index_out();
@@ -169,14 +186,24 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true) {
     b.l.at.z -= 0.01;
     b.step();
   }
-  // The index pad up under the overhang at 10 mm/s; the thumb closes in 0.4 s.
-  for (int i = 0; i < 680; ++i) {
-    b.r.at.z += 0.01;
-    b.step();
+  // The pinching tool along a straight line, MM_PER_STEP each 1 ms step.
+  auto go = [&](Vec3 to, double mm_per_step) {
+    const Vec3 from = b.r.at;
+    const int n = std::max(1, static_cast<int>(std::lround(sheet::norm(to - from) / mm_per_step)));
+    for (int i = 1; i <= n; ++i) {
+      b.r.at = from + (to - from) * (static_cast<double>(i) / n);
+      b.step();
+    }
+  };
+  if (grasp.from_beyond) {  // round the overhang at 40 mm/s: down beyond it, in under it
+    go({at.x, 190.0 + kSheetDyMm, kTableMm - grasp.under_mm}, 0.04);
+    go({at.x, at.y, kTableMm - grasp.under_mm}, 0.04);
   }
+  // The index pad up under the overhang at 10 mm/s; the thumb closes in 0.4 s.
+  go({at.x, at.y, kTableMm - 1.2}, 0.01);
   b.hold(0.1);
   for (int i = 1; i <= 500; ++i) {
-    b.r.q[THJ5] = 0.3 + (kCloseThj5 - 0.3) * std::min(1.0, i / 400.0);
+    b.r.q[THJ5] = grasp.open_thj5 + (kCloseThj5 - grasp.open_thj5) * std::min(1.0, i / 400.0);
     b.step();
   }
   Fold out;
@@ -244,4 +271,19 @@ TEST_CASE("the hands fold the sheet in half: one pinches the far edge and lays i
   CHECK_FALSE(f.near_drag_mm >= 10.0);
   CHECK(loose.near_drag_mm >= 10.0);  // the pinch drags the unheld sheet after it
   CHECK_FALSE(folded(loose));
+}
+
+TEST_CASE("the hand pinches the drooping far edge from beyond it, round the overhang, and folds; straight in at the pinch's height it pushes the edge away") {
+  // As config/folds/half.yaml's grasp: down beyond the edge to 35 mm under the table top, in, up.
+  Bimanual b;
+  const Fold f = fold(nominal(), b, true, from_beyond(35.0));
+  print("from beyond, round the overhang", f);
+  CHECK(f.pinch_n > 0.1);
+  CHECK(folded(f));
+  CHECK(f.near_drag_mm < 10.0);
+  // Failing variant: in at 8 mm under the table top, where the drooping edge hangs.
+  Bimanual b0;
+  const Fold high = fold(nominal(), b0, true, from_beyond(8.0));
+  print("from beyond, in at 8 mm", high);
+  CHECK_FALSE(folded(high));
 }
