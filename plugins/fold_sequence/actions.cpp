@@ -88,7 +88,7 @@ void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
 }
 
 void Machine::arm_park(int side, Outbox& out) noexcept {
-  const int s = side == kPinching ? spec_.pinching_side : 1 - spec_.pinching_side;  // park poses are per side
+  const int s = side_of_role(spec_, side);  // park poses are per side
   arm_move(side, m_.arm_has_target[side] ? m_.arm_tool[side] : 0, ArmGoal::world, spec_.park_mm[s],
            spec_.park_orientation[s], spec_.retreat, 0, out);
 }

@@ -42,7 +42,20 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
     return h != nullptr && m_.hand_id[s] != 0 && h->goal_id == m_.hand_id[s] && h->mode == HandMode::force &&
            h->settled != 0;
   };
-  auto posed = [&](int s) { return this->posed(s, in); };
+  // The side's posture goal of this state ramped to its end (the targets no longer move).
+  auto ramp_ended = [&](int s) {
+    const HandControlStatus* h = in.hand[s];
+    return h != nullptr && m_.hand_id[s] != 0 && h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture &&
+           h->max_step_rad <= 1e-6f;
+  };
+  auto posed = [&](int s) {
+    const HandControlStatus* h = in.hand[s];
+    if (m_.hand_id[s] == 0) return true;
+    if (h == nullptr) return false;
+    // Refused (in the fold a fault first), or the controller's own retreat: nothing more to wait for.
+    if (h->goals_refused > m_.hand_refused0[s] || h->mode == HandMode::retreat) return true;
+    return ramp_ended(s);
+  };
   switch (ev) {
     case Ev::start: return m_.start_pending != 0;
     case Ev::timeout: return timed_out(owner);
@@ -61,10 +74,8 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
       // The closing ended and every pinching pad measures the squeeze. Not contact_state's
       // fingers: a finger still following its ramped targets reads as a contact there, with
       // the corner nowhere between the pads.
+      if (!ramp_ended(kPinching)) return false;
       const HandControlStatus* h = in.hand[kPinching];
-      if (h == nullptr || m_.hand_id[kPinching] == 0 || h->goal_id != m_.hand_id[kPinching] || h->mode != HandMode::posture ||
-          h->max_step_rad > 1e-6f)
-        return false;
       for (int f = 0; f < HandControlStatus::kFingers; ++f)
         if ((spec_.pinch_fingers & (1u << f)) != 0 && !(h->force_n[f] >= spec_.pinch_force_n)) return false;
       return true;
@@ -96,15 +107,6 @@ double Machine::slide_length(const Sensing& in, double d_sheet[2]) const noexcep
   d_sheet[0] = d[0] * f.x[0] + d[1] * f.x[1] + d[2] * f.x[2];
   d_sheet[1] = d[0] * f.y[0] + d[1] * f.y[1] + d[2] * f.y[2];
   return std::hypot(d[0], d[1]);
-}
-
-bool Machine::posed(int s, const Sensing& in) const noexcept {
-  const HandControlStatus* h = in.hand[s];
-  if (m_.hand_id[s] == 0) return true;
-  if (h == nullptr) return false;
-  // Refused (in the fold a fault first), or the controller's own retreat: nothing more to wait for.
-  if (h->goals_refused > m_.hand_refused0[s] || h->mode == HandMode::retreat) return true;
-  return h->goal_id == m_.hand_id[s] && h->mode == HandMode::posture && h->max_step_rad <= 1e-6f;
 }
 
 bool Machine::passes(Guard g, const Sensing& in) const noexcept {

@@ -19,7 +19,7 @@ void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
   // Role s (kFixing, kPinching) on the ports of its side.
   const char* side[2] = {"r", "l"};
   for (int s = 0; s < 2; ++s) {
-    const std::string x = side[s == kPinching ? spec_.pinching_side : 1 - spec_.pinching_side];
+    const std::string x = side[side_of_role(spec_, s)];
     arm_status_[s] = ports.latest_input<ArmMotionStatus>("arm_" + x + "_status");
     hand_status_[s] = ports.latest_input<HandControlStatus>("hand_" + x + "_status");
     contact_[s] = ports.latest_input<ContactState>("contact_" + x + "_state");

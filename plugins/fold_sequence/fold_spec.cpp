@@ -62,6 +62,21 @@ void sheet_point(const Params& p, const char* key, double* out) {
   out[2] = -out[2];
 }
 
+// The grasp's list KEY of at most kMaxGraspPath `{at_mm}` points on the way to BEFORE, each
+// with its (required) `orientation` when ORIENTATION is given; returns how many.
+int grasp_points(const Params& p, const char* key, const char* before, double (*mm)[3], double (*orientation)[4]) {
+  const std::vector<Params> list = p.list(key);
+  if (list.size() > static_cast<std::size_t>(kMaxGraspPath))
+    p.fail(key, "expected at most " + std::to_string(kMaxGraspPath) + " points before " + before);
+  const int n = static_cast<int>(list.size());
+  for (int i = 0; i < n; ++i) {
+    const Params& v = list[static_cast<std::size_t>(i)];
+    sheet_point(v, "at_mm", mm[i]);
+    if (orientation != nullptr) quaternion(v, "orientation", orientation[i], true);
+  }
+  return n;
+}
+
 std::uint8_t tool(const Params& p, const char* key, std::uint8_t fallback) {
   if (!p.has(key)) return fallback;
   const std::string name = p.get<std::string>(key);
@@ -193,21 +208,10 @@ void read(const Params& p, FoldSpec& f) {
   f.grasp_tool = tool(b, "tool", 4);
   f.pinch_fingers = fingers(b, "pinch_fingers", 0x11);
   f.pinch_force_n = b.get_in_range<double>("pinch_force_n", 0.2, 0.01, 10.0);
-  const std::vector<Params> above_via = b.list("above_via");
-  if (above_via.size() > static_cast<std::size_t>(kMaxGraspPath))
-    b.fail("above_via", "expected at most " + std::to_string(kMaxGraspPath) + " points before above_mm");
-  f.grasp_above_via_count = static_cast<int>(above_via.size());
-  for (int i = 0; i < f.grasp_above_via_count; ++i) {
-    const Params& v = above_via[static_cast<std::size_t>(i)];
-    sheet_point(v, "at_mm", f.grasp_above_via_mm[i]);
-    quaternion(v, "orientation", f.grasp_above_via_orientation[i], true);
-  }
+  f.grasp_above_via_count =
+      grasp_points(b, "above_via", "above_mm", f.grasp_above_via_mm, f.grasp_above_via_orientation);
   sheet_point(b, "above_mm", f.grasp_above_mm);
-  const std::vector<Params> path = b.list("path");
-  if (path.size() > static_cast<std::size_t>(kMaxGraspPath))
-    b.fail("path", "expected at most " + std::to_string(kMaxGraspPath) + " points before at_mm");
-  f.grasp_path_count = static_cast<int>(path.size());
-  for (int i = 0; i < f.grasp_path_count; ++i) sheet_point(path[static_cast<std::size_t>(i)], "at_mm", f.grasp_path_mm[i]);
+  f.grasp_path_count = grasp_points(b, "path", "at_mm", f.grasp_path_mm, nullptr);
   sheet_point(b, "at_mm", f.grasp_at_mm);
   quaternion(b, "orientation", f.grasp_orientation);
 

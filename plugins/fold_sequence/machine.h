@@ -33,6 +33,11 @@ namespace crease::fold {
 inline constexpr int kFixing = 0;    // the role index of Sensing's and Outbox's arrays
 inline constexpr int kPinching = 1;
 
+// The side (0 right, 1 left) that plays ROLE in fold F.
+[[nodiscard]] inline int side_of_role(const FoldSpec& f, int role) noexcept {
+  return role == kPinching ? f.pinching_side : 1 - f.pinching_side;
+}
+
 // One cycle's sensing; a null pointer: never written. Timestamps are compared with now_ns.
 struct Sensing {
   std::int64_t now_ns = 0;
@@ -130,8 +135,6 @@ class Machine {
   // conditions.cpp: events, guards, faults.
   [[nodiscard]] bool holds(Ev ev, S owner, const Sensing& in) const noexcept;
   [[nodiscard]] bool passes(Guard g, const Sensing& in) const noexcept;
-  // The side's last posture goal ramped to its end (or refused, or overridden by a retreat).
-  [[nodiscard]] bool posed(int side, const Sensing& in) const noexcept;
   [[nodiscard]] Reason fault(const Sensing& in) noexcept;  // Reason::none when all is well
   [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2]) const noexcept;
   // actions.cpp: entry and exit actions, the goals.
