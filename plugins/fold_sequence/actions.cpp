@@ -234,14 +234,30 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], f.via_orientation[m_.via], f.fold, 0, out);
       break;
     case S::bend_crease: m_.via = 0; break;
-    case S::layer_approach: approach(kPinching, f.fixate_layer, out); break;
-    case S::layer_contact: descend(kPinching, f.fixate_layer, out); break;
-    case S::layer_press: hand_force(kPinching, f.fixate_layer.fingers, f.fixate_layer.force_n, in, out); break;
+    case S::layer_lay: {
+      const int last = f.via_count - 1;
+      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.lay_mm, f.via_orientation[last], f.contact, 0, out);
+      break;
+    }
+    case S::refix_slide_out: {
+      // Out from under the bent layer along the table, pressing lightly: the near half stays.
+      hand_force(kFixing, f.shift.fingers, f.refixate_out_force_n, in, out);
+      const double p[3] = {f.refixate_out_mm[0], f.refixate_out_mm[1], -f.slide_height_mm};
+      arm_move(kFixing, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+      break;
+    }
     case S::refix_open: hand_posture(kFixing, f.open_rad, in, out); break;
     case S::refix_lift: arm_lift(kFixing, f.release_lift_mm, out); break;
     case S::refix_approach: approach(kFixing, f.refixate, out); break;
     case S::refix_contact: descend(kFixing, f.refixate, out); break;
     case S::refix_press: hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out); break;
+    case S::swipe_release: hand_posture(kPinching, f.prepinch_rad, in, out); break;
+    case S::swipe_withdraw: {
+      const int last = f.via_count - 1;
+      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.swipe_withdraw_mm, f.via_orientation[last], f.contact, 0,
+               out);
+      break;
+    }
     case S::swipe_open:
     case S::harden_open: hand_posture(kPinching, f.open_rad, in, out); break;
     case S::swipe_lift:

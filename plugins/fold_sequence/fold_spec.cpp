@@ -227,11 +227,15 @@ void read(const Params& p, FoldSpec& f) {
     quaternion(v, "orientation", f.via_orientation[i]);
   }
 
-  f.fixate_layer = contact_step(p.child("fixate_layer"), 5, true);
-  f.refixate = contact_step(p.child("refixate"), 0, true);
+  sheet_point(p.child("fixate_layer"), "lay_mm", f.lay_mm);
+  const Params rf = p.child("refixate");
+  f.refixate = contact_step(rf, 0, true);
+  numbers(rf, "out_mm", 2, f.refixate_out_mm);
+  f.refixate_out_force_n = rf.get_in_range<double>("out_force_n", 0.5, 0.0, 10.0);
   f.release_lift_mm = p.get_in_range<double>("release_lift_mm", 30.0, 0.0, 300.0);
   const Params sw = p.child("swipe");
   f.swipe = contact_step(sw, 0, true);
+  sheet_point(sw, "withdraw_mm", f.swipe_withdraw_mm);
   numbers(sw, "to_mm", 2, f.swipe_to_mm);
   const Params hd = p.child("harden");
   f.harden = contact_step(hd, 0, false);

@@ -100,12 +100,21 @@ struct FoldSpec {
   double via_mm[kMaxVia][3] = {};
   double via_orientation[kMaxVia][4] = {};
 
-  // (d) the pinching hand's finger backs on the bent layer; (e) the fixing hand on both layers.
-  ContactStep fixate_layer;
+  // (d) the pinch lays the bent layer on the stack and holds it there: the pinching tool to
+  // lay_mm (sheet frame), turned as the last via point.
+  double lay_mm[3] = {};
+  // (e) the fixing hand, under the bent layer since (b), slides out from under it to
+  // refixate_out_mm (u, v; at slide_height_mm) pressing with refixate_out_force_n, opens,
+  // lifts, and lands on both layers as `refixate` says.
+  double refixate_out_mm[2] = {0, 0};
+  double refixate_out_force_n = 0.5;
   ContactStep refixate;
   double release_lift_mm = 30;     // a hand lifts this far after it opened (e, f, g)
 
-  // (f) the coarse swipe: the pinching hand lands at swipe.at and slides to swipe_to_mm (u, v).
+  // (f) the pinch opens to prepinch_rad (the thumb off the edge), its tool moves to
+  // swipe_withdraw_mm (sheet frame, the pads off the edge), the hand opens and lifts; the coarse
+  // swipe: the pinching hand lands at swipe.at and slides to swipe_to_mm (u, v).
+  double swipe_withdraw_mm[3] = {};
   ContactStep swipe;
   double swipe_to_mm[2] = {0, 0};
 

@@ -69,7 +69,7 @@ enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, 
 
 struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
-  static constexpr std::uint32_t kVersion = 2;  // 2: grasp/shape
+  static constexpr std::uint32_t kVersion = 3;  // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)

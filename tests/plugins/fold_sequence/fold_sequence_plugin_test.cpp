@@ -25,11 +25,11 @@ const std::vector<std::string> kHalfPath = {
     "fold/bend/crease", "fold/bend/follow_via[0]", "fold/bend/follow_via[1]", "fold/bend/follow_via[2]",
     "fold/bend/follow_via[3]", "fold/bend/follow_via[4]", "fold/bend/follow_via[5]", "fold/bend/follow_via[6]",
     "fold/bend/follow_via[7]",
-    "fold/fixate_layer/approach", "fold/fixate_layer/contact", "fold/fixate_layer/press",
-    "fold/refixate/open", "fold/refixate/lift", "fold/refixate/approach", "fold/refixate/contact",
-    "fold/refixate/press",
-    "fold/swipe/open", "fold/swipe/lift", "fold/swipe/approach", "fold/swipe/contact", "fold/swipe/press",
-    "fold/swipe/slide",
+    "fold/fixate_layer/lay",
+    "fold/refixate/slide_out", "fold/refixate/open", "fold/refixate/lift", "fold/refixate/approach",
+    "fold/refixate/contact", "fold/refixate/press",
+    "fold/swipe/release", "fold/swipe/withdraw", "fold/swipe/open", "fold/swipe/lift", "fold/swipe/approach",
+    "fold/swipe/contact", "fold/swipe/press", "fold/swipe/slide",
     "fold/harden/open", "fold/harden/lift", "fold/harden/approach", "fold/harden/contact", "fold/harden/press",
     "fold/harden/slide",
     "fold/finish/memorize", "fold/finish/open", "fold/finish/lift", "fold/finish/park",
@@ -193,6 +193,43 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
     CHECK(g.speed_mm_s == 40.0f);
   }
   CHECK(near(pinching[5]->arm_goal.orientation[0][0], -0.52423));  // the pinch turned 90 deg with the sheet
+  // (d) the pinch lays the layer 12 mm over the stack, turned as the last via point.
+  REQUIRE(pinching.size() >= 12);
+  const ArmGoal& lay = pinching[10]->arm_goal;
+  CHECK(near(lay.position_mm[0][1], 14.5));
+  CHECK(near(lay.position_mm[0][2], -12.0));
+  CHECK(near(lay.orientation[0][0], -0.40748));
+  // (e) the fixing hand, pressing 0.5 N, slides out from under the layer along the table, off the
+  // sheet's side, before it opens and lands on both layers; the pinch has not let go meanwhile.
+  const auto fix_after = r.all(kFix, Sent::arm, pinching[10]->cycle);
+  REQUIRE(fix_after.size() >= 4);
+  const ArmGoal& out = fix_after[0]->arm_goal;
+  CHECK(near(out.position_mm[0][0], 255.0));
+  CHECK(near(out.position_mm[0][1], 88.5));
+  CHECK(near(out.position_mm[0][2], 0.0));
+  CHECK(out.stop_on == ArmGoal::stop_none);
+  const auto fix_hand_after = r.all(kFix, Sent::hand, pinching[10]->cycle);
+  REQUIRE(fix_hand_after.size() >= 2);
+  CHECK(fix_hand_after[0]->hand_goal.mode == HandMode::force);
+  CHECK(fix_hand_after[0]->hand_goal.force_n == 0.5f);
+  CHECK(fix_hand_after[1]->hand_goal.mode == HandMode::posture);  // then it opens
+  CHECK(fix_hand_after[1]->cycle >= fix_after[0]->cycle + r.move_cycles);
+  CHECK(near(fix_after[2]->arm_goal.position_mm[0][1], 40.0));  // over both layers
+  // (f) once both layers are held, the pinch opens to prepinch (the thumb only), then its pads
+  // leave the edge (straight up), then the hand opens.
+  const auto pin_hand_after = r.all(kPin, Sent::hand, pinching[10]->cycle);
+  REQUIRE(pin_hand_after.size() >= 2);
+  const auto fix_force = r.all(kFix, Sent::hand, fix_after[3]->cycle);
+  REQUIRE(!fix_force.empty());
+  CHECK(pin_hand_after[0]->cycle > fix_force[0]->cycle);  // after the fixing press on both layers
+  CHECK(pin_hand_after[0]->hand_goal.target_rad[15] == doctest::Approx(0.0));   // THJ5 open
+  CHECK(pin_hand_after[0]->hand_goal.target_rad[3] == doctest::Approx(1.428));  // the index still curled
+  const ArmGoal& withdraw = pinching[11]->arm_goal;
+  CHECK(pinching[11]->cycle >= pin_hand_after[0]->cycle + r.posture_cycles);
+  CHECK(near(withdraw.position_mm[0][1], 14.5));
+  CHECK(near(withdraw.position_mm[0][2], -37.0));  // straight up off the laid edge
+  CHECK(pin_hand_after[1]->cycle >= pinching[11]->cycle + r.move_cycles);
+  for (float t : pin_hand_after[1]->hand_goal.target_rad) CHECK(t == 0.0f);  // open
   // (g) the hardening stroke along the model's crease, inset 10 mm, 4 mm onto the stack.
   const Sent* hs = nullptr;
   for (const Sent* s : pinching)

@@ -60,7 +60,11 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.fold_line_mm[0][1] == 148.5);
   CHECK(h.via_mm[1][2] == -60.3);  // [u, v, h]: h above the sheet is the sheet frame's -z
   CHECK(h.shift.fingers == 0x03);
-  CHECK(h.fixate_layer.tool == 5);  // ff_back
+  CHECK(h.lay_mm[1] == 14.5);
+  CHECK(h.lay_mm[2] == -12.0);
+  CHECK(h.refixate_out_mm[0] == 255.0);
+  CHECK(h.refixate_out_force_n == 0.5);
+  CHECK(h.swipe_withdraw_mm[2] == -37.0);
   CHECK(h.pinch_fingers == 0x11);
   CHECK(h.pinching_side == 0);      // the right hand pinches
   CHECK(h.pinch_force_n == 0.2);
@@ -104,10 +108,16 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(e.find("fold.shift.corner_mm: required") != std::string::npos);
   }
   SUBCASE("an unknown tool frame") {
-    const int line = line_of("  tool: ff_back");
-    const std::string e = error_of(variant("  tool: ff_back", "  tool: ff_bak"));
+    const int line = line_of("  tool: ff_pad\n  fingers: [ff, mf, rf]");
+    const std::string e = error_of(variant("  tool: ff_pad\n  fingers: [ff, mf, rf]", "  tool: ff_bak\n  fingers: [ff, mf, rf]"));
     CHECK(e.find(tmp + ":" + std::to_string(line) + ":") == 0);
-    CHECK(e.find("fold.fixate_layer.tool: unknown tool frame 'ff_bak'") != std::string::npos);
+    CHECK(e.find("fold.swipe.tool: unknown tool frame 'ff_bak'") != std::string::npos);
+  }
+  SUBCASE("a missing lay point, where the fixing hand slides out to") {
+    CHECK(error_of(variant("  lay_mm: [105, 14.5, 12]\n", "  {}\n")).find("fold.fixate_layer.lay_mm: required") !=
+          std::string::npos);
+    CHECK(error_of(variant("  out_mm: [255, 88.5]", "  out_mm: [255]")).find("fold.refixate.out_mm: expected a list of 2") !=
+          std::string::npos);
   }
   SUBCASE("an unknown finger") {
     const std::string e = error_of(variant("pinch_fingers: [th, ff]", "pinch_fingers: [th, xx]"));
