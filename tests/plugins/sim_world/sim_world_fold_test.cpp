@@ -112,6 +112,7 @@ struct Fold {
   double worst_slip_mm = 0;   // of the pinched node against the index pad, over the fold
   double near_drag_mm = 0;    // how far the near edge moved (the fixation's hold)
   double edges_apart_mm = 0;  // mean over the columns: far-edge node to near-edge node, in x, y
+  double peak_n = 0;          // the highest normal force on a pinching fingertip over the fold (what its taxels read)
   double on_top = 0;          // fraction of the far half's nodes (rows 0-15) above their mirror node (40 - row) by > 0.5 mm
 };
 
@@ -226,6 +227,7 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {
     b.step();
     const Vec3 rel = b.world->sheet().positions()[node] - pad(b.hand(Side::right), 0);
     out.worst_slip_mm = std::max(out.worst_slip_mm, sheet::norm(rel - rel0));
+    for (const auto& t : b.hand(Side::right).tip) out.peak_n = std::max(out.peak_n, double(t.normal_force_n));
   }
   b.hold(0.5);
   out.near_drag_mm = std::fabs(near_edge_y(*b.world) - near0);
@@ -242,7 +244,7 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {
 }
 
 void print(const std::string& tag, const Fold& f) {
-  MESSAGE(tag << ": pinch " << f.pinch_n << " N, worst slip " << f.worst_slip_mm << " mm, near edge dragged "
+  MESSAGE(tag << ": pinch " << f.pinch_n << " N (peak " << f.peak_n << " N), worst slip " << f.worst_slip_mm << " mm, near edge dragged "
               << f.near_drag_mm << " mm; far edge " << f.edges_apart_mm << " mm from the near edge, "
               << 100.0 * f.on_top << " % of the far half on top of the near half");
 }
