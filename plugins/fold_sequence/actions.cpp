@@ -93,6 +93,11 @@ void Machine::arm_park(int side, Outbox& out) noexcept {
            spec_.park_orientation[s], spec_.retreat, 0, out);
 }
 
+void Machine::pinch_as_laid(const double p[3], Outbox& out) noexcept {
+  arm_move(kPinching, spec_.grasp_tool, ArmGoal::sheet, p, spec_.via_orientation[spec_.via_count - 1], spec_.contact,
+           0, out);
+}
+
 void Machine::push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) noexcept {
   if (out.hand_count[side] >= Outbox::kPerPort) {
     out.overflow = true;
@@ -234,11 +239,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], f.via_orientation[m_.via], f.fold, 0, out);
       break;
     case S::bend_crease: m_.via = 0; break;
-    case S::layer_lay: {
-      const int last = f.via_count - 1;
-      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.lay_mm, f.via_orientation[last], f.contact, 0, out);
-      break;
-    }
+    case S::layer_lay: pinch_as_laid(f.lay_mm, out); break;
     case S::refix_slide_out: {
       // Out from under the bent layer along the table, pressing lightly: the near half stays.
       hand_force(kFixing, f.shift.fingers, f.refixate_out_force_n, in, out);
@@ -252,12 +253,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::refix_contact: descend(kFixing, f.refixate, out); break;
     case S::refix_press: hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out); break;
     case S::swipe_release: hand_posture(kPinching, f.prepinch_rad, in, out); break;
-    case S::swipe_withdraw: {
-      const int last = f.via_count - 1;
-      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.swipe_withdraw_mm, f.via_orientation[last], f.contact, 0,
-               out);
-      break;
-    }
+    case S::swipe_withdraw: pinch_as_laid(f.swipe_withdraw_mm, out); break;
     case S::swipe_open:
     case S::harden_open: hand_posture(kPinching, f.open_rad, in, out); break;
     case S::swipe_lift:

@@ -150,6 +150,9 @@ class Machine {
   void arm_stop(int side, Outbox& out) noexcept;
   void arm_lift(int side, double lift_mm, Outbox& out) noexcept;
   void arm_park(int side, Outbox& out) noexcept;
+  // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
+  // pinch as the bend laid it (lay, withdraw).
+  void pinch_as_laid(const double p[3], Outbox& out) noexcept;
   void hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out) noexcept;
   void hand_force(int side, std::uint8_t fingers, double force_n, const Sensing& in, Outbox& out) noexcept;
   void hand_hold(int side, const Sensing& in, Outbox& out) noexcept;

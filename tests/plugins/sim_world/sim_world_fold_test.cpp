@@ -159,6 +159,16 @@ struct Grasp {
 
 Grasp from_beyond(double under_mm) { return {true, 115.0, 0.0, under_mm}; }
 
+// B's arm A's tool along a straight line to TO, MM_PER_STEP each 1 ms step.
+void move(Bimanual& b, Arm& a, Vec3 to, double mm_per_step) {
+  const Vec3 from = a.at;
+  const int n = std::max(1, static_cast<int>(std::lround(sheet::norm(to - from) / mm_per_step)));
+  for (int i = 1; i <= n; ++i) {
+    a.at = from + (to - from) * (static_cast<double>(i) / n);
+    b.step();
+  }
+}
+
 // FIXATE false: the left index hovers 8 mm over the near half instead of pressing it.
 Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {}) {
   REQUIRE(p.table_height_mm == kTableMm);
@@ -190,15 +200,7 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {
     b.l.at.z -= 0.01;
     b.step();
   }
-  // The pinching tool along a straight line, MM_PER_STEP each 1 ms step.
-  auto go = [&](Vec3 to, double mm_per_step) {
-    const Vec3 from = b.r.at;
-    const int n = std::max(1, static_cast<int>(std::lround(sheet::norm(to - from) / mm_per_step)));
-    for (int i = 1; i <= n; ++i) {
-      b.r.at = from + (to - from) * (static_cast<double>(i) / n);
-      b.step();
-    }
-  };
+  auto go = [&](Vec3 to, double mm_per_step) { move(b, b.r, to, mm_per_step); };
   if (grasp.from_beyond) {  // round the overhang at 40 mm/s: down beyond it, in under it
     go({at.x, 190.0 + kSheetDyMm, kTableMm - grasp.under_mm}, 0.04);
     go({at.x, at.y, kTableMm - grasp.under_mm}, 0.04);
@@ -244,19 +246,9 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {
 }
 
 void print(const std::string& tag, const Fold& f) {
-  MESSAGE(tag << ": pinch " << f.pinch_n << " N (peak " << f.peak_n << " N), worst slip " << f.worst_slip_mm << " mm, near edge dragged "
-              << f.near_drag_mm << " mm; far edge " << f.edges_apart_mm << " mm from the near edge, "
+  MESSAGE(tag << ": pinch " << f.pinch_n << " N (peak " << f.peak_n << " N), worst slip " << f.worst_slip_mm
+              << " mm, near edge dragged " << f.near_drag_mm << " mm; far edge " << f.edges_apart_mm << " mm from the near edge, "
               << 100.0 * f.on_top << " % of the far half on top of the near half");
-}
-
-// Tool TOOL of B's arm A along a straight line to TO, MM_PER_STEP each 1 ms step.
-void move(Bimanual& b, Arm& a, Vec3 to, double mm_per_step) {
-  const Vec3 from = a.at;
-  const int n = std::max(1, static_cast<int>(std::lround(sheet::norm(to - from) / mm_per_step)));
-  for (int i = 1; i <= n; ++i) {
-    a.at = from + (to - from) * (static_cast<double>(i) / n);
-    b.step();
-  }
 }
 
 // After the fold (the left index out from under the layer): config/folds/half.yaml's (e) and (f).
