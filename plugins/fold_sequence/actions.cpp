@@ -62,6 +62,7 @@ void Machine::arm_path(int side, std::uint8_t tool, std::uint8_t frame, int n, c
     for (int c = 0; c < 4; ++c) g.orientation[k][c] = orientation[k][c];
   }
   m_.arm_id[side] = g.id;
+  m_.arm_sent_ns[side] = m_.last_ns;
   m_.arm_has_target[side] = 1;
   m_.arm_frame[side] = frame;
   m_.arm_tool[side] = tool;
@@ -158,6 +159,26 @@ void Machine::stop_for_pause(Outbox& out) noexcept {
     if (m_.held_by_pause[s]) hand_hold(s, none, out);
   }
   for (int s = 0; s < 2; ++s) m_.hand_id[s] = 0;
+}
+
+void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
+  if (m_.leaf != S::abort_lift && m_.leaf != S::abort_park) return;
+  for (int s = 0; s < 2; ++s) {
+    const ArmMotionStatus* a = in.arm[s];
+    if (retreat_end(a, m_.arm_id[s]) != RetreatEnd::retry ||
+        static_cast<double>(m_.last_ns - m_.arm_sent_ns[s]) * 1e-9 < kRetryS)
+      continue;
+    out.retried[s] = a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason;
+    ++m_.retreat_retries;
+    if (m_.leaf == S::abort_lift) {
+      arm_lift(s, spec_.release_lift_mm, out);  // from where it is now: up again
+      continue;
+    }
+    const HandControlStatus* h = in.hand[s];
+    if (h != nullptr && (h->mode == HandMode::retreat || h->inhibit != HandInhibit::none))
+      hand_posture(s, spec_.open_rad, in, out);  // taken, it clears the latch that refuses the park
+    arm_park(s, out);
+  }
 }
 
 void Machine::exit(S s, const Sensing& in, Outbox& out) noexcept {

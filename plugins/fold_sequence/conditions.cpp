@@ -17,14 +17,35 @@ bool moving(const ArmMotionStatus* a) noexcept {
                           a->state == ArmMotionStatus::stopping);
 }
 
-// The goal `id` ended one way or another (reached, stopped, refused, aborted).
-bool ended(const ArmMotionStatus* a, std::uint32_t id) noexcept {
-  if (id == 0 || a == nullptr) return true;
-  if (a->last_refused_id == id) return true;
-  return a->goal_id == id && !moving(a) && a->state != ArmMotionStatus::idle;
+// A refusal or abort that the same goal sent again cannot mend: the goal itself, or a drive in
+// fault (its driver commanded the safe state; a drive back from a fault is a new start). A stale
+// arm_state (arm_stale, arm_not_ready) is one of a loaded machine's moments.
+bool for_good(std::uint8_t reason) noexcept {
+  switch (static_cast<ArmMotionReason>(reason)) {
+    case ArmMotionReason::arm_fault:
+    case ArmMotionReason::non_finite:
+    case ArmMotionReason::bad_orientation:
+    case ArmMotionReason::unknown_tool:
+    case ArmMotionReason::bad_points:
+    case ArmMotionReason::bad_limits:
+    case ArmMotionReason::outside_workspace:
+    case ArmMotionReason::no_sheet:
+    case ArmMotionReason::unreachable:
+    case ArmMotionReason::joint_speed: return true;
+    default: return false;
+  }
 }
 
 }  // namespace
+
+RetreatEnd retreat_end(const ArmMotionStatus* a, std::uint32_t id) noexcept {
+  if (id == 0) return RetreatEnd::reached;  // nothing sent: an arm that never moved
+  if (a == nullptr) return RetreatEnd::pending;
+  if (a->last_refused_id == id) return for_good(a->last_refusal) ? RetreatEnd::gave_up : RetreatEnd::retry;
+  if (a->goal_id != id || moving(a) || a->state == ArmMotionStatus::idle) return RetreatEnd::pending;
+  if (a->state == ArmMotionStatus::reached || a->state == ArmMotionStatus::stopped_on_contact) return RetreatEnd::reached;
+  return for_good(a->reason) ? RetreatEnd::gave_up : RetreatEnd::retry;
+}
 
 bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
   auto reached = [&](int s) {
@@ -91,7 +112,12 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
         if (!hand_ok || moving(in.arm[s])) return false;
       }
       return true;
-    case Ev::arms_done: return ended(in.arm[kFixing], m_.arm_id[kFixing]) && ended(in.arm[kPinching], m_.arm_id[kPinching]);
+    case Ev::arms_done:
+      for (int s = 0; s < 2; ++s) {
+        const RetreatEnd e = retreat_end(in.arm[s], m_.arm_id[s]);
+        if (e != RetreatEnd::reached && e != RetreatEnd::gave_up) return false;
+      }
+      return true;
     case Ev::always: return true;
   }
   return false;

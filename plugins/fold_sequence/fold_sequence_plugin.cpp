@@ -76,6 +76,12 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   if (out.has_crease) lost |= !crease_.try_push(out.crease);
   if (out.has_memorize) lost |= !memorize_.try_push(out.memorize);
   if (lost) machine_->fail(Reason::command_lost);
+  for (int r = 0; r < 2; ++r)
+    if (out.retried[r] != Outbox::kNoRetry)
+      log_rt(rt::LogLevel::warn,
+             r == kFixing ? "retreat: the fixing arm's goal ended short (arm_motion reason), sent again"
+                          : "retreat: the pinching arm's goal ended short (arm_motion reason), sent again",
+             out.retried[r]);
 
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);

@@ -215,6 +215,7 @@ void Machine::step(const Sensing& in, Outbox& out) noexcept {
       }
     }
   }
+  retry_retreat(in, out);  // no transition this cycle
 }
 
 }  // namespace crease::fold

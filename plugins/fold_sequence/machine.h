@@ -38,6 +38,15 @@ inline constexpr int kPinching = 1;
   return role == kPinching ? f.pinching_side : 1 - f.pinching_side;
 }
 
+// How a retreat goal (a lift, a park) stands, from arm_motion's status: still under way (or its
+// status not yet about it), reached, ended short for good (a refusal or abort that a retry
+// cannot mend: unreachable, outside the workspace, a bad goal, the drive in fault), or ended
+// short for a reason that may pass (the arm's state stale, the hand's controller retreating,
+// busy): sent again.
+enum class RetreatEnd : std::uint8_t { pending, reached, gave_up, retry };
+[[nodiscard]] RetreatEnd retreat_end(const ArmMotionStatus* a, std::uint32_t id) noexcept;
+inline constexpr double kRetryS = 0.1;  // a retreat goal sent again at most this often
+
 // One cycle's sensing; a null pointer: never written. Timestamps are compared with now_ns.
 struct Sensing {
   std::int64_t now_ns = 0;
@@ -59,9 +68,14 @@ struct Outbox {
   SheetMemorizeEvent memorize;
   bool has_memorize = false;
   bool overflow = false;  // a state sent more than kPerPort to one port (a bug of the tables)
+  // The retreat sent role r's lift or park again: why the last one ended short (an
+  // ArmMotionReason), kNoRetry when it did not.
+  static constexpr std::uint8_t kNoRetry = 0xff;
+  std::uint8_t retried[2] = {kNoRetry, kNoRetry};
   void clear() noexcept {
     arm_count[0] = arm_count[1] = hand_count[0] = hand_count[1] = 0;
     has_crease = has_memorize = overflow = false;
+    retried[0] = retried[1] = kNoRetry;
   }
 };
 
@@ -69,7 +83,9 @@ enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, 
 
 struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
-  static constexpr std::uint32_t kVersion = 3;  // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw
+  // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
+  // retreat's retries (arm_sent_ns, retreat_retries)
+  static constexpr std::uint32_t kVersion = 4;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -101,6 +117,8 @@ struct Memory {
   std::uint8_t arm_has_target[2] = {0, 0};
   std::uint8_t arm_frame[2] = {0, 0};
   std::uint8_t arm_tool[2] = {0, 0};
+  std::int64_t arm_sent_ns[2] = {0, 0};  // when the last move goal was sent
+  std::uint32_t retreat_retries = 0;     // retreat goals sent again (retry_retreat)
   double arm_target[2][3] = {};       // the last move goal's target (its frame)
   double arm_orientation[2][4] = {};
   std::uint32_t crease_count0 = 0;    // sheet_state's creases when the crease was sent
@@ -141,6 +159,10 @@ class Machine {
   void enter(S s, const Sensing& in, Outbox& out) noexcept;
   void exit(S s, const Sensing& in, Outbox& out) noexcept;
   void stop_for_pause(Outbox& out) noexcept;
+  // abort/lift, abort/park, each cycle without a transition: an arm whose lift or park ended
+  // short for a reason that may pass (retreat_end) gets it again, at most every kRetryS; a
+  // hand whose controller retreats is opened again with it (its latch cleared, the park taken).
+  void retry_retreat(const Sensing& in, Outbox& out) noexcept;
   void arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                 const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;  // 0: no stop
   // One motion through the n points of path_mm (1..ArmGoal::kMaxPoints), the tool turned to

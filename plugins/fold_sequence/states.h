@@ -53,7 +53,8 @@ enum class Ev : std::uint8_t {
   memorized,      // a sheet_state newer than the memorize request (the model consumed it)
   stopped,        // abort: both hands took the hold goal (or retreat on their own, or refused
                   // it), and neither arm runs a motion
-  arms_done,      // abort: both arms' goals ended (reached, refused or aborted)
+  arms_done,      // abort: both arms' goals reached, or ended short for good (retreat_end;
+                  // one short for a reason that may pass is sent again, retry_retreat)
   always,         // at once (a completion)
 };
 

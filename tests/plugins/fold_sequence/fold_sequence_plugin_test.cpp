@@ -429,6 +429,84 @@ TEST_CASE("the abort opens the hands again once lifted, before the park") {
   }
 }
 
+// The retreat must end with the arms lifted and parked even when arm_motion cannot take a goal
+// for a moment (on a loaded machine the world fell behind, the arm's state went stale: the lift
+// aborted as arm_stale, the park was refused as arm_not_ready, and the retreat ended with a
+// hand 14 mm over the sheet): a lift or park that ended short for such a reason is sent again,
+// at most every kRetryS, until it is reached or the state times out. One refused for good
+// (unreachable) is not sent again. A park refused behind the hand's retreat opens it again first.
+TEST_CASE("the retreat sends a lift or park again that ended short for a reason that may pass") {
+  using crease::fold::kRetryS;
+  const auto moves_after = [](const Rig& r, long from) {
+    std::vector<const ArmGoal*> g;
+    for (const Sent* x : r.all(kFix, Sent::arm, from))
+      if (x->arm_goal.kind == ArmGoal::move) g.push_back(&x->arm_goal);
+    return g;
+  };
+  SUBCASE("the lift aborts as arm_stale, the park is refused twice as arm_not_ready: both sent again") {
+    Rig r;
+    const long abort_at = start_and_run_to(r, "fold/shift/press");
+    int lifts = 0, parks = 0;
+    r.abort_as = [&](int s, const ArmGoal& g, int) {
+      return s == kFix && g.frame == ArmGoal::measured && lifts++ == 0 ? ArmMotionReason::arm_stale
+                                                                       : ArmMotionReason::none;
+    };
+    r.refuse_as = [&](int s, const ArmGoal& g, int) {
+      return s == kFix && g.frame == ArmGoal::world && parks++ < 2 ? ArmMotionReason::arm_not_ready
+                                                                   : ArmMotionReason::none;
+    };
+    r.command(Command::abort);
+    REQUIRE(r.run_to("aborted", 20000));
+    const auto p = r.paths();
+    CHECK(std::vector<std::string>(p.end() - static_cast<long>(kRetreat.size()), p.end()) == kRetreat);  // no extra states
+    const auto g = moves_after(r, abort_at);
+    REQUIRE(g.size() == 5);  // lift, lift again, park, park again, park again (reached)
+    CHECK(g[0]->frame == ArmGoal::measured);
+    CHECK(g[1]->frame == ArmGoal::measured);
+    for (int k = 2; k < 5; ++k) CHECK(g[static_cast<std::size_t>(k)]->frame == ArmGoal::world);
+    CHECK(g[4]->position_mm[0][2] == 300.0);
+    // Sent again no sooner than kRetryS after the one before.
+    const auto sent = r.all(kFix, Sent::arm, abort_at);
+    for (std::size_t k = 1; k < sent.size(); ++k)
+      if (sent[k]->arm_goal.frame == sent[k - 1]->arm_goal.frame && sent[k]->arm_goal.kind == ArmGoal::move)
+        CHECK(sent[k]->cycle - sent[k - 1]->cycle >= static_cast<long>(kRetryS * 1000));
+  }
+  SUBCASE("a park refused as unreachable is not sent again: the retreat ends at once") {
+    Rig r;
+    const long abort_at = start_and_run_to(r, "fold/shift/press");
+    r.refuse_as = [&](int s, const ArmGoal& g, int) {
+      return s == kFix && g.frame == ArmGoal::world ? ArmMotionReason::unreachable : ArmMotionReason::none;
+    };
+    r.command(Command::abort);
+    REQUIRE(r.run_to("abort/park", 20000));
+    const long park_at = r.cycles();
+    REQUIRE(r.run_to("aborted", 1000));
+    CHECK(r.cycles() - park_at < static_cast<long>(kRetryS * 1000));
+    CHECK(moves_after(r, abort_at).size() == 2);  // the lift, the park
+  }
+  SUBCASE("a park refused behind the hand's retreat: the hand opened again, then the park") {
+    Rig r;
+    const long abort_at = start_and_run_to(r, "fold/shift/press");
+    int parks = 0;
+    r.refuse_as = [&](int s, const ArmGoal& g, int) {
+      return s == kFix && g.frame == ArmGoal::world && parks++ == 0 ? ArmMotionReason::hand_retreat
+                                                                    : ArmMotionReason::none;
+    };
+    r.inhibit[kFix] = HandInhibit::force_limit;  // latched, and still so at the park
+    r.command(Command::abort);
+    REQUIRE(r.run_to("aborted", 20000));
+    std::vector<long> park_cycles;
+    for (const Sent* x : r.all(kFix, Sent::arm, abort_at))
+      if (x->arm_goal.kind == ArmGoal::move && x->arm_goal.frame == ArmGoal::world) park_cycles.push_back(x->cycle);
+    REQUIRE(park_cycles.size() == 2);
+    const auto opens = r.all(kFix, Sent::hand, park_cycles[0] + 1);
+    REQUIRE(!opens.empty());
+    CHECK(opens.front()->cycle <= park_cycles[1]);  // opened again with the park sent again
+    CHECK(opens.front()->hand_goal.mode == HandMode::posture);
+    for (float q : opens.front()->hand_goal.target_rad) CHECK(q == 0.0f);
+  }
+}
+
 TEST_CASE("the start waits until the controllers answer and the sheet is seen") {
   Rig r;
   r.observations = 0;  // the model runs but vision sees nothing

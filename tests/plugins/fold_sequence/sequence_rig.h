@@ -177,6 +177,14 @@ class Rig {
   // Per arm goal (side, goal, index of the side's move goals): refuse as unreachable / never end.
   std::function<bool(int, const ArmGoal&, int)> unreachable = [](int, const ArmGoal&, int) { return false; };
   std::function<bool(int, const ArmGoal&, int)> stalls = [](int, const ArmGoal&, int) { return false; };
+  // Per arm move goal: refused at once with this reason (as arm_motion's refuse), or run half
+  // its cycles and then aborted with it (an arm_state gone stale, say); none: as usual.
+  std::function<ArmMotionReason(int, const ArmGoal&, int)> refuse_as = [](int, const ArmGoal&, int) {
+    return ArmMotionReason::none;
+  };
+  std::function<ArmMotionReason(int, const ArmGoal&, int)> abort_as = [](int, const ArmGoal&, int) {
+    return ArmMotionReason::none;
+  };
   HandInhibit inhibit[2] = {HandInhibit::none, HandInhibit::none};
   bool arm_fault[2] = {false, false};  // the running motion aborts with arm_fault
   bool refuse_hand_goals[2] = {false, false};  // every hand goal refused (inputs bad)
@@ -188,6 +196,7 @@ class Rig {
   struct Arm {
     ArmMotionStatus st{};
     ArmGoal goal{};
+    ArmMotionReason abort_as = ArmMotionReason::none;
     int left = 0;  // cycles to go
     bool stall = false;
     int moves = 0;
@@ -205,6 +214,9 @@ class Rig {
         if (arm_fault[s]) {
           a.st.state = ArmMotionStatus::aborted;
           a.st.reason = static_cast<std::uint8_t>(ArmMotionReason::arm_fault);
+        } else if (a.abort_as != ArmMotionReason::none && a.left <= move_cycles / 2) {
+          a.st.state = ArmMotionStatus::aborted;
+          a.st.reason = static_cast<std::uint8_t>(a.abort_as);
         } else if (!a.stall && --a.left <= 0) {
           if (a.goal.stop_on == ArmGoal::contact_onset) {
             a.st.state = ArmMotionStatus::stopped_on_contact;
@@ -275,7 +287,18 @@ class Rig {
           a.st.reason = static_cast<std::uint8_t>(ArmMotionReason::unreachable);
           continue;
         }
+        if (const ArmMotionReason why = refuse_as(s, g, index); why != ArmMotionReason::none) {
+          a.st.last_refused_id = g.id;
+          a.st.last_refusal = static_cast<std::uint8_t>(why);
+          if (a.st.state != ArmMotionStatus::running) {
+            a.st.goal_id = g.id;
+            a.st.state = ArmMotionStatus::refused;
+            a.st.reason = static_cast<std::uint8_t>(why);
+          }
+          continue;
+        }
         a.goal = g;
+        a.abort_as = abort_as(s, g, index);
         a.st.goal_id = g.id;
         a.st.state = ArmMotionStatus::running;
         a.st.reason = 0;
