@@ -181,6 +181,17 @@ void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
   }
 }
 
+void Machine::report_retreat(const Sensing& in, Outbox& out) noexcept {
+  if (m_.leaf != S::abort_lift && m_.leaf != S::abort_park) return;
+  for (int s = 0; s < 2; ++s) {
+    const ArmMotionStatus* a = in.arm[s];
+    if (m_.arm_id[s] == 0 || m_.gave_up_id[s] == m_.arm_id[s] || retreat_end(a, m_.arm_id[s]) != RetreatEnd::gave_up)
+      continue;
+    m_.gave_up_id[s] = m_.arm_id[s];
+    out.gave_up[s] = a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason;
+  }
+}
+
 void Machine::exit(S s, const Sensing& in, Outbox& out) noexcept {
   (void)in;
   (void)out;

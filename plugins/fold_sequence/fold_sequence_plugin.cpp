@@ -82,6 +82,12 @@ Status FoldSequencePlugin::update(const Cycle& c) {
              r == kFixing ? "retreat: the fixing arm's goal ended short (arm_motion reason), sent again"
                           : "retreat: the pinching arm's goal ended short (arm_motion reason), sent again",
              out.retried[r]);
+  for (int r = 0; r < 2; ++r)
+    if (out.gave_up[r] != Outbox::kNoRetry)
+      log_rt(rt::LogLevel::warn,
+             r == kFixing ? "retreat: the fixing arm's goal ended short for good (arm_motion reason)"
+                          : "retreat: the pinching arm's goal ended short for good (arm_motion reason)",
+             out.gave_up[r]);
 
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);

@@ -192,6 +192,7 @@ void Machine::step(const Sensing& in, Outbox& out) noexcept {
   } else {
     external_fault_ = Reason::none;
   }
+  report_retreat(in, out);
   const bool held = m_.paused || m_.gate_row >= 0;
   const RowSpan rows = all_rows();
   // Two passes: a fault's rows (fold's) first, so that a fault preempts any success of the same

@@ -72,10 +72,11 @@ struct Outbox {
   // ArmMotionReason), kNoRetry when it did not.
   static constexpr std::uint8_t kNoRetry = 0xff;
   std::uint8_t retried[2] = {kNoRetry, kNoRetry};
+  std::uint8_t gave_up[2] = {kNoRetry, kNoRetry};  // ... or ended it for good, and why
   void clear() noexcept {
     arm_count[0] = arm_count[1] = hand_count[0] = hand_count[1] = 0;
     has_crease = has_memorize = overflow = false;
-    retried[0] = retried[1] = kNoRetry;
+    retried[0] = retried[1] = gave_up[0] = gave_up[1] = kNoRetry;
   }
 };
 
@@ -119,6 +120,7 @@ struct Memory {
   std::uint8_t arm_tool[2] = {0, 0};
   std::int64_t arm_sent_ns[2] = {0, 0};  // when the last move goal was sent
   std::uint32_t retreat_retries = 0;     // retreat goals sent again (retry_retreat)
+  std::uint32_t gave_up_id[2] = {0, 0};  // the last retreat goal reported as ended for good
   double arm_target[2][3] = {};       // the last move goal's target (its frame)
   double arm_orientation[2][4] = {};
   std::uint32_t crease_count0 = 0;    // sheet_state's creases when the crease was sent
@@ -163,6 +165,9 @@ class Machine {
   // short for a reason that may pass (retreat_end) gets it again, at most every kRetryS; a
   // hand whose controller retreats is opened again with it (its latch cleared, the park taken).
   void retry_retreat(const Sensing& in, Outbox& out) noexcept;
+  // abort/lift, abort/park, each cycle before the rows: a retreat goal that ended for good is
+  // reported once (Outbox::gave_up), since the arm stays where that left it.
+  void report_retreat(const Sensing& in, Outbox& out) noexcept;
   void arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                 const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;  // 0: no stop
   // One motion through the n points of path_mm (1..ArmGoal::kMaxPoints), the tool turned to

@@ -161,7 +161,7 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
       const std::int64_t t0 = rt::now_ns();
       auto since = [&](std::int64_t from) { return static_cast<double>(rt::now_ns() - from) * 1e-9; };
       host.set_param(fold, "command", 1.0);  // creasectl sequence start: taken when the guard passes
-      std::int64_t started_ns = 0, ended_ns = 0;
+      std::int64_t started_ns = 0, ended_ns = 0, sampled_ns = 0;
       std::uint32_t seen_transitions = 0;
       std::set<std::string> fold_states;
       bool operator_abort = false, grasp_reference = false;
@@ -174,10 +174,17 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
         }
         status->poll();
         const SequenceStatus& s = status->value();
+        double force_now[2] = {0, 0};
         if (world_state->poll().has_data()) {
           for (int h = 0; h < 2; ++h)
             for (const WorldFingertip& t : world_state->value().hand[h].tip)
-              r.max_force_n[h] = std::max(r.max_force_n[h], double(t.normal_force_n));
+              force_now[h] = std::max(force_now[h], double(t.normal_force_n));
+          for (int h = 0; h < 2; ++h) r.max_force_n[h] = std::max(r.max_force_n[h], force_now[h]);
+        }
+        if (started_ns != 0 && rt::now_ns() - sampled_ns >= static_cast<std::int64_t>(kSeriesS * 1e9)) {
+          sampled_ns = rt::now_ns();
+          const double stretch = truth->poll().has_data() ? max_stretch(truth->value()) : std::nan("");
+          r.series.push_back({since(started_ns), {force_now[0], force_now[1]}, stretch});
         }
         if (started_ns == 0 && s.phase != SequenceStatus::idle) {
           started_ns = rt::now_ns();
@@ -296,6 +303,14 @@ double num(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : s
 nlohmann::json to_json(const TrialResult& r) {
   nlohmann::json timeline = nlohmann::json::array();
   for (const auto& e : r.timeline) timeline.push_back({{"t_s", e.t_s}, {"path", e.path}, {"why", e.why}});
+  nlohmann::json series = {{"t_s", nlohmann::json::array()}, {"force_r_n", nlohmann::json::array()},
+                           {"force_l_n", nlohmann::json::array()}, {"stretch", nlohmann::json::array()}};
+  for (const auto& x : r.series) {
+    series["t_s"].push_back(x.t_s);
+    series["force_r_n"].push_back(num(x.force_n[0]));
+    series["force_l_n"].push_back(num(x.force_n[1]));
+    series["stretch"].push_back(num(x.stretch));
+  }
   const Score& s = r.score;
   return {{"trial", r.index},
           {"seed", r.seed},
@@ -328,6 +343,7 @@ nlohmann::json to_json(const TrialResult& r) {
           {"success", r.success},
           {"failure", r.failure},
           {"timeline", timeline},
+          {"series", series},
           {"error", r.error}};
 }
 
@@ -366,6 +382,12 @@ TrialResult from_json(const nlohmann::json& j) {
   r.failure = j.at("failure").get<std::string>();
   for (const auto& e : j.at("timeline"))
     r.timeline.push_back({e.at("t_s").get<double>(), e.at("path").get<std::string>(), e.at("why").get<std::string>()});
+  if (j.contains("series")) {
+    const auto& x = j.at("series");
+    for (std::size_t k = 0; k < x.at("t_s").size(); ++k)
+      r.series.push_back({x.at("t_s")[k].get<double>(), {num(x.at("force_r_n")[k]), num(x.at("force_l_n")[k])},
+                          num(x.at("stretch")[k])});
+  }
   r.error = j.at("error").get<std::string>();
   return r;
 }

@@ -34,6 +34,14 @@ struct TimelineEntry {
   std::string path, why;
 };
 
+// The trial over time, from the world's truth, every kSeriesS.
+struct SeriesSample {
+  double t_s = 0;              // since the sequence's start
+  double force_n[2] = {0, 0};  // each hand's largest fingertip normal force (world_state)
+  double stretch = 0;          // the sheet's largest edge stretch (sheet_truth), NaN before one
+};
+inline constexpr double kSeriesS = 0.02;
+
 struct TrialResult {
   int index = 0;
   std::uint64_t seed = 0;
@@ -54,6 +62,7 @@ struct TrialResult {
   bool success = false;
   std::string failure;       // the first reason it is not a success ("" for a success)
   std::vector<TimelineEntry> timeline;
+  std::vector<SeriesSample> series;
   std::string error;
 };
 

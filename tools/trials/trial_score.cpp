@@ -137,6 +137,24 @@ bool fit_base(const SheetState& s, const FoldTarget& t, PlaneMotion& out, int* c
   return ok;
 }
 
+double max_stretch(const SheetState& s) {
+  const int W = s.nodes_u, H = s.nodes_v;
+  if (nodes(s) < 4 || nodes(s) > static_cast<int>(SheetState::kMaxNodes)) return kNaN;
+  const double du = W > 1 ? s.width_mm / (W - 1) : 1.0, dv = H > 1 ? s.height_mm / (H - 1) : 1.0;
+  double worst = 0;
+  for (int j = 0; j < H; ++j)
+    for (int i = 0; i < W; ++i) {
+      const float* x = s.position_mm[j * W + i];
+      auto stretch = [&](const float* y, double rest) {
+        const double d = std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]));
+        worst = std::max(worst, (d - rest) / rest);
+      };
+      if (i + 1 < W) stretch(s.position_mm[j * W + i + 1], du);
+      if (j + 1 < H) stretch(s.position_mm[(j + 1) * W + i], dv);
+    }
+  return worst;
+}
+
 Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b, const SheetState* reference) {
   Score r;
   r.fold_line_mm = r.fold_angle_deg = r.corners_mm = r.retained_deg = r.slip_mm = kNaN;
@@ -212,7 +230,6 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
   }
 
   // Damage: the grid's edges against their rest lengths; below the table.
-  const double du = W > 1 ? s.width_mm / (W - 1) : 1.0, dv = H > 1 ? s.height_mm / (H - 1) : 1.0;
   double zmin = 1e9;
   int below = 0;
   for (int j = 0; j < H; ++j)
@@ -220,13 +237,8 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
       const float* x = pos(i, j);
       zmin = std::min(zmin, double(x[2]));
       below += x[2] < -kBelowTableMm;
-      auto stretch = [&](const float* y, double rest) {
-        const double d = std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]));
-        r.max_stretch = std::max(r.max_stretch, (d - rest) / rest);
-      };
-      if (i + 1 < W) stretch(pos(i + 1, j), du);
-      if (j + 1 < H) stretch(pos(i, j + 1), dv);
     }
+  r.max_stretch = max_stretch(s);
   r.torn = r.max_stretch > kTornStretch;
   r.off_table = below >= kOffTableFraction * W * H;
 

@@ -90,6 +90,9 @@ struct PlaneMotion {
 // The base's rigid motion, fitted to its nodes (false: fewer than three).
 bool fit_base(const SheetState& s, const FoldTarget& t, PlaneMotion& out, int* nodes = nullptr);
 
+// The largest relative stretch of an edge of SHEET's grid (its rest length the grid spacing).
+[[nodiscard]] double max_stretch(const SheetState& sheet);
+
 // The score of SHEET (the world's truth at the end), REFERENCE (the truth the slip is measured
 // from; null: slip NaN).
 [[nodiscard]] Score score_sheet(const SheetState& sheet, const FoldTarget& target, const Bounds& bounds,
