@@ -58,8 +58,16 @@ class ForceController final : public Plugin {
     HandCommand cmd;
     HandControlStatus st;
     const bool commanding = controller_.step_rt(in, cmd, st);
-    for (const HandControlEvent& e : controller_.events())
+    for (const HandControlEvent& e : controller_.events()) {
       if (!events_.try_push(e)) ++events_dropped_;
+      if (e.kind == HandControlEvent::force_limit_fault) {
+        static constexpr const char* kWhat[kFingers] = {
+            "force limit: ff measured over force_limit_n (mN), retreat", "force limit: mf measured over force_limit_n (mN), retreat",
+            "force limit: rf measured over force_limit_n (mN), retreat", "force limit: lf measured over force_limit_n (mN), retreat",
+            "force limit: th measured over force_limit_n (mN), retreat"};
+        log_rt(rt::LogLevel::warn, kWhat[e.finger < kFingers ? e.finger : 0], static_cast<std::int64_t>(e.value * 1000.0f));
+      }
+    }
     controller_.clear_events();
     if (commanding) command_.write(cmd, c.time_ns);
     status_.write(st, c.time_ns);

@@ -162,6 +162,7 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
       auto since = [&](std::int64_t from) { return static_cast<double>(rt::now_ns() - from) * 1e-9; };
       host.set_param(fold, "command", 1.0);  // creasectl sequence start: taken when the guard passes
       std::int64_t started_ns = 0, ended_ns = 0, sampled_ns = 0;
+      double window_force[2] = {0, 0};  // each hand's largest fingertip force since the last sample
       std::uint32_t seen_transitions = 0;
       std::set<std::string> fold_states;
       bool operator_abort = false, grasp_reference = false;
@@ -174,17 +175,17 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
         }
         status->poll();
         const SequenceStatus& s = status->value();
-        double force_now[2] = {0, 0};
         if (world_state->poll().has_data()) {
           for (int h = 0; h < 2; ++h)
             for (const WorldFingertip& t : world_state->value().hand[h].tip)
-              force_now[h] = std::max(force_now[h], double(t.normal_force_n));
-          for (int h = 0; h < 2; ++h) r.max_force_n[h] = std::max(r.max_force_n[h], force_now[h]);
+              window_force[h] = std::max(window_force[h], double(t.normal_force_n));
+          for (int h = 0; h < 2; ++h) r.max_force_n[h] = std::max(r.max_force_n[h], window_force[h]);
         }
         if (started_ns != 0 && rt::now_ns() - sampled_ns >= static_cast<std::int64_t>(kSeriesS * 1e9)) {
           sampled_ns = rt::now_ns();
           const double stretch = truth->poll().has_data() ? max_stretch(truth->value()) : std::nan("");
-          r.series.push_back({since(started_ns), {force_now[0], force_now[1]}, stretch});
+          r.series.push_back({since(started_ns), {window_force[0], window_force[1]}, stretch});
+          window_force[0] = window_force[1] = 0;
         }
         if (started_ns == 0 && s.phase != SequenceStatus::idle) {
           started_ns = rt::now_ns();

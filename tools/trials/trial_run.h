@@ -37,7 +37,7 @@ struct TimelineEntry {
 // The trial over time, from the world's truth, every kSeriesS.
 struct SeriesSample {
   double t_s = 0;              // since the sequence's start
-  double force_n[2] = {0, 0};  // each hand's largest fingertip normal force (world_state)
+  double force_n[2] = {0, 0};  // each hand's largest fingertip normal force (world_state) since the last sample
   double stretch = 0;          // the sheet's largest edge stretch (sheet_truth), NaN before one
 };
 inline constexpr double kSeriesS = 0.02;
