@@ -215,7 +215,10 @@ int Daemon::run() {
   host_->poll();
   print_summary(*host_, {double(rt::now_ns() - facts_.start_ns) * 1e-9, stop_reason_, figures});
   const std::optional<std::string> dir = options_.report_dir ? options_.report_dir : config_.daemon.report_dir;
-  if (dir) write_reports(*host_, facts_, *dir);
+  if (dir) {
+    const std::vector<report::FigureSummary> summaries = figure_summaries(figures);  // as the run left them
+    write_reports(*host_, facts_, *dir, &summaries);
+  }
   return 0;
 }
 

@@ -33,13 +33,17 @@ std::vector<FigureReading> FigureWatch::take() {
   return now;
 }
 
-std::vector<report::FigureSummary> figure_summaries(const PortRegistry& ports) {
+std::vector<report::FigureSummary> figure_summaries(const std::vector<FigureReading>& figures) {
   std::vector<report::FigureSummary> out;
-  for (const FigureReading& r : FigureWatch(ports).take()) {
+  for (const FigureReading& r : figures) {
     out.push_back({r.port, r.figure.label, r.figure.unit, r.figure.sample, r.figure.count, r.figure.mean(),
                    r.figure.last, r.figure.max});
   }
   return out;
+}
+
+std::vector<report::FigureSummary> figure_summaries(const PortRegistry& ports) {
+  return figure_summaries(FigureWatch(ports).take());
 }
 
 std::string progress_text(const std::vector<FigureReading>& figures) {

@@ -34,6 +34,9 @@ class FigureWatch {
 
 // Every figure now (by port name), as the report and `creasectl stats` show it.
 [[nodiscard]] std::vector<report::FigureSummary> figure_summaries(const PortRegistry& ports);
+// The same of figures taken earlier (FigureWatch::take): the report creased writes at its end
+// takes them before the host drives every output, these too, to its safe value.
+[[nodiscard]] std::vector<report::FigureSummary> figure_summaries(const std::vector<FigureReading>& figures);
 
 // "; LABEL: X UNIT (this second), Y UNIT (mean so far)" for each figure with samples.
 [[nodiscard]] std::string progress_text(const std::vector<FigureReading>& figures);

@@ -139,11 +139,13 @@ std::vector<report::PortTraffic> port_traffic(const PortRegistry& ports) {
   return out;
 }
 
-void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir) {
+void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir,
+                   const std::vector<report::FigureSummary>* figures) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(dir, ec);
-  const report::TimingReport r = build_report(host, facts);
+  report::TimingReport r = build_report(host, facts);
+  if (figures != nullptr) r.figures = *figures;
   for (const auto& [format, name] : {std::pair{report::Format::html, "report.html"}, std::pair{report::Format::json, "report.json"},
                                      std::pair{report::Format::text, "report.txt"}}) {
     const fs::path p = fs::path(dir) / name;

@@ -29,7 +29,9 @@ struct RunFacts {
 [[nodiscard]] std::vector<report::PortTraffic> port_traffic(const PortRegistry& ports);
 
 // Writes DIR/report.{html,json,txt} (DIR created when missing) and prints where they are; a
-// file that cannot be written is logged, the others are still written.
-void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir);
+// file that cannot be written is logged, the others are still written. FIGURES, when given, are
+// the report's figures instead of the ports' values now (after a stop: their safe values).
+void write_reports(const PluginHost& host, const RunFacts& facts, const std::string& dir,
+                   const std::vector<report::FigureSummary>* figures = nullptr);
 
 }  // namespace crease::daemon

@@ -1,10 +1,15 @@
 // The report creased writes lists every port of the host, frame channels too.
 #include "core/daemon/report_builder.h"
 
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>
 
+#include "core/daemon/figures.h"
 #include "core/port.h"
 #include "core/port_types/figure.h"
 #include "core/report/render.h"
@@ -61,4 +66,34 @@ TEST_CASE("the report and every rendering carry the figures the plugins report; 
   CHECK(j.get<crease::report::TimingReport>().figures.size() == 1);
   j.erase("figures");
   CHECK(j.get<crease::report::TimingReport>().figures.empty());
+}
+
+// creased writes its report after the host stopped, which drives every output, a Figure port
+// too, to its safe value (count 0): the report's figures are the ones taken before the stop, as
+// the console's summary prints them (a report without them showed every figure at 0 samples).
+TEST_CASE("the report written at the end carries the figures taken before the stop, not the safe values") {
+  crease::PluginHost host({});
+  auto* ch = host.ports().bind_latest_writer("tracking_error", crease::port_type_of<crease::Figure>(), "score");
+  crease::Figure f = crease::Figure::named("tracking error", "mm", "model frames");
+  f.count = 3;
+  f.sum = 12.0;
+  f.last = 5.0;
+  f.max = 6.0;
+  ch->write(&f, 1);
+  crease::daemon::FigureWatch watch(host.ports());
+  const auto taken = crease::daemon::figure_summaries(watch.take());
+  const crease::Figure safe{};
+  ch->write(&safe, 2);  // the stop: the output's safe value
+  char tmpl[] = "/tmp/crease-report-XXXXXX";
+  const std::filesystem::path dir = mkdtemp(tmpl);
+  auto count_in = [&](const std::vector<crease::report::FigureSummary>* figures) {
+    crease::daemon::write_reports(host, crease::daemon::RunFacts{}, dir.string(), figures);
+    std::ifstream in(dir / "report.json");
+    const auto j = nlohmann::json::parse(in);
+    REQUIRE(j["figures"].size() == 1);
+    return j["figures"][0]["count"].get<std::uint64_t>();
+  };
+  CHECK(count_in(&taken) == 3);
+  CHECK(count_in(nullptr) == 0);  // the ports now: what the report showed before
+  std::filesystem::remove_all(dir);
 }
