@@ -17,7 +17,7 @@ namespace crease {
 
 struct ArmGoal {
   static constexpr char kPortType[] = "crease.ArmGoal";
-  static constexpr std::uint32_t kPortVersion = 1;
+  static constexpr std::uint32_t kPortVersion = 2;  // 2: interpolation
   static constexpr int kMaxPoints = 8;
 
   enum Kind : std::uint8_t {
@@ -34,6 +34,13 @@ struct ArmGoal {
                    // frame applied to the measured orientation (identity: keep it). A lift
                    // from where the arm is, wherever a stopped motion left it.
   };
+  enum Interpolation : std::uint8_t {
+    cartesian = 0,  // the tool frame along straight lines through the points (the IK each cycle)
+    joints = 1,     // one point, no stop condition: its pose solved once (the IK seeded from the
+                    // arm's first measured posture, where it started parked), then every joint
+                    // on one smooth profile to it: a retreat to the parking pose from a pose
+                    // whose straight line there the arm cannot follow (a wrist turned by a bend)
+  };
   enum StopOn : std::uint8_t {
     stop_none = 0,
     contact_onset = 1,  // contact_state reports a new onset (its `onsets` counter rose since the
@@ -48,6 +55,7 @@ struct ArmGoal {
   std::uint8_t point_count = 0;  // 1..kMaxPoints: via points, the last is the target
   std::uint8_t stop_on = stop_none;
   std::uint8_t stop_fingers = 0x1f;  // bit f: finger f (ff mf rf lf th)
+  std::uint8_t interpolation = cartesian;
   // Limits of the tool frame's motion along its path (each > 0, at most arm_motion's params).
   float speed_mm_s = 0;
   float accel_mm_s2 = 0;

@@ -74,6 +74,7 @@ void ArmMotion::finish(ArmMotionStatus::State st, ArmMotionReason r) noexcept {
 void ArmMotion::begin_stop(ArmMotionStatus::State end, ArmMotionReason r) noexcept {
   s_.phase = ArmMotionStatus::stopping;
   s_.profile.stopping = 1;
+  if (s_.joint_move) stop_joint_profile(s_.joint, s_.v_cmd);
   s_.end_state = end;
   s_.end_reason = static_cast<std::uint8_t>(r);
 }
@@ -133,6 +134,16 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   const KDL::Frame off = ik_.tool_offset();
   const PathPose o = to_pose(off);
   ik_.set_tool_offset(tool, to_frame(o));  // as load_state will: a swapped motion runs the same numbers
+  double q_goal[kArmJoints];
+  if (g.interpolation == ArmGoal::joints) {
+    const PathPose& t = path.pose[1];
+    const KDL::Frame target = to_frame(t);
+    const std::span<const double, kArmJoints> seed(s_.have_home ? s_.home_q : s_.q_cmd, kArmJoints);
+    if (!ik_.solve(target, seed, std::span<double, kArmJoints>(q_goal, kArmJoints)).converged) {
+      refuse(g.id, ArmMotionReason::unreachable);
+      return;
+    }
+  }
   if (g.frame == ArmGoal::measured) {
     // From where the arm is (its readiness above: a fresh arm_state), not where it was commanded.
     double q_meas[kArmJoints];
@@ -153,7 +164,7 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   path.pose[0] = to_pose(ik_.tool_pose(q_cmd));
   path.count = g.point_count + 1;
   // While the hand retreats only a lift goes (away from what it pressed); any other is refused.
-  const bool lift = path_is_lift(path);
+  const bool lift = g.interpolation == ArmGoal::cartesian && path_is_lift(path);
   if (!lift && hand_retreating(in)) {
     refuse(g.id, ArmMotionReason::hand_retreat);
     return;
@@ -166,6 +177,7 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   s_.path = path;
   s_.profile = PathProfile{};
   s_.phase = ArmMotionStatus::checking;
+  s_.joint_move = g.interpolation == ArmGoal::joints ? 1 : 0;
   s_.tool = g.tool;
   s_.stop_on = g.stop_on;
   s_.stop_fingers = g.stop_fingers;
@@ -177,6 +189,27 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   s_.status.goal_id = g.id;
   s_.status.reason = 0;
   s_.status.tool = g.tool;
+  if (s_.joint_move) {  // within the limits all the way: runs from this cycle
+    double vmax[kArmJoints];
+    for (int j = 0; j < kArmJoints; ++j) vmax[j] = p_.joint_speed_fraction * ik_.velocity_limit()[j];
+    s_.joint = joint_profile(s_.q_cmd, q_goal, vmax, p_.joint_accel_rad_s2);
+    s_.phase = ArmMotionStatus::running;
+    ++s_.status.goals_accepted;
+  }
+}
+
+void ArmMotion::run_joints(const CycleInputs& in) noexcept {
+  if (s_.phase == ArmMotionStatus::running && hand_retreating(in))
+    begin_stop(ArmMotionStatus::aborted, ArmMotionReason::hand_retreat);
+  step_joint_profile(s_.joint, in.dt_s, p_.joint_accel_rad_s2, s_.q_cmd, s_.v_cmd);
+  speed_m_s_ = 0;
+  if (!s_.joint.done) return;
+  for (double& v : s_.v_cmd) v = 0;
+  if (s_.phase == ArmMotionStatus::stopping) {
+    finish(static_cast<ArmMotionStatus::State>(s_.end_state), static_cast<ArmMotionReason>(s_.end_reason));
+  } else {
+    finish(ArmMotionStatus::reached, ArmMotionReason::none);
+  }
 }
 
 void ArmMotion::check_path(const CycleInputs& in) noexcept {
@@ -236,6 +269,10 @@ void ArmMotion::check_path(const CycleInputs& in) noexcept {
 }
 
 void ArmMotion::run(const CycleInputs& in) noexcept {
+  if (s_.joint_move) {
+    run_joints(in);
+    return;
+  }
   if (s_.phase == ArmMotionStatus::running && s_.lift == 0 && hand_retreating(in)) {
     begin_stop(ArmMotionStatus::aborted, ArmMotionReason::hand_retreat);
   } else if (s_.phase == ArmMotionStatus::running && s_.stop_on == ArmGoal::contact_onset) {
@@ -281,6 +318,10 @@ bool ArmMotion::step(const CycleInputs& in) noexcept {
       s_.v_cmd[j] = 0;
     }
     s_.have_cmd = 1;
+    if (!s_.have_home) {  // where it started (parked): the joints goals' IK seed
+      std::memcpy(s_.home_q, s_.q_cmd, sizeof(s_.home_q));
+      s_.have_home = 1;
+    }
   }
   s_.arm_was_ready = ready == Readiness::ready;
   if (active(s_.phase) && ready != Readiness::ready) {
@@ -316,6 +357,14 @@ void ArmMotion::publish(const CycleInputs& in) noexcept {
   st.progress = has_path ? static_cast<float>(path_progress(s_.path, s_.profile)) : 0.0f;
   if (s_.phase == ArmMotionStatus::checking) st.progress = 0;
   st.distance_to_go_mm = has_path ? static_cast<float>(1000.0 * distance_to_go_m(s_.path, s_.profile)) : 0.0f;
+  if (has_path && s_.joint_move) {  // the straight distance, scaled by the profile's progress
+    const double done = joint_profile_progress(s_.joint);
+    const PathPose& a = s_.path.pose[0];
+    const PathPose& b = s_.path.pose[1];
+    st.progress = static_cast<float>(done);
+    st.distance_to_go_mm = static_cast<float>(
+        1000.0 * (1.0 - done) * std::hypot(b.p_m[0] - a.p_m[0], b.p_m[1] - a.p_m[1], b.p_m[2] - a.p_m[2]));
+  }
   st.speed_mm_s = moving ? static_cast<float>(1000.0 * speed_m_s_) : 0.0f;
   st.ik_error_mm = static_cast<float>(1000.0 * ik_error_m_);
 }

@@ -19,6 +19,12 @@
 // and the IK tracks the new pose warm from the last command (ArmIk::track); the command's
 // velocity is the step over the cycle.
 //
+// A joints goal (ArmGoal::joints, one pose in the world or sheet frame) is solved once on
+// arrival (ArmIk::solve seeded from the arm's first measured posture, where it started parked:
+// the solution on that branch), refused as unreachable without one, and run at once on one
+// quintic profile in joint space (joint_profile.h: within joint_speed_fraction of the velocity
+// limits and joint_accel_rad_s2): every sample lies within the joint limits, so nothing is
+// checked ahead; its tool frame does not follow a straight line. Stops as any motion does.
 // A goal in the `measured` frame is relative to the tool frame's measured pose when it arrives
 // (the forward kinematics of arm_state's angles): a lift from where the arm is.
 // Stop condition (contact_onset): checked every running cycle before the profile steps, so a
@@ -49,6 +55,7 @@
 #include "core/port_types/hand_control.h"
 #include "plugins/arm_motion/cartesian_path.h"
 #include "plugins/arm_motion/goal_check.h"
+#include "plugins/arm_motion/joint_profile.h"
 #include "plugins/robot_model/arm_ik.h"
 
 namespace crease::arm_motion {
@@ -64,6 +71,7 @@ struct MotionParams {
   double check_step_mm = 5.0;
   double check_step_rad = 0.05;
   double joint_speed_fraction = 0.9;       // of the URDF's velocity limits
+  double joint_accel_rad_s2 = 1.5;         // a joints goal's acceleration limit, every joint
   double tracking_tolerance_mm = 0.01;     // the IK residual a running cycle accepts
   double tracking_tolerance_rad = 1e-5;
   // The trajectory's jerk limits (the goal carries none): along the path (mm/s^3), in rotation
@@ -104,6 +112,10 @@ struct MotionState {
   std::uint8_t stop_on = 0;
   std::uint8_t stop_fingers = 0;
   std::uint8_t lift = 0;        // a lift (goal_check.h): the hand's retreat does not stop it
+  std::uint8_t joint_move = 0;  // the motion is a joints goal's (joint), not the path's
+  std::uint8_t have_home = 0;
+  double home_q[robot::kArmJoints] = {};  // the first measured posture: a joints goal's IK seed
+  JointProfile joint;
   std::uint64_t onsets_at_start = 0;
   double offset_p[3] = {};             // flange -> tool, metres
   double offset_quat[4] = {0, 0, 0, 1};
@@ -146,6 +158,7 @@ class ArmMotion {
   void begin_stop(ArmMotionStatus::State end, ArmMotionReason r) noexcept;
   void check_path(const CycleInputs& in) noexcept;
   void run(const CycleInputs& in) noexcept;
+  void run_joints(const CycleInputs& in) noexcept;
   void publish(const CycleInputs& in) noexcept;
 
   MotionParams p_;

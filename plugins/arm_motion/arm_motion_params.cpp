@@ -70,6 +70,7 @@ ArmMotionConfig parse_arm_motion_params(const Params& p) {
   m.check_step_mm = p.get_in_range<double>("check_step_mm", m.check_step_mm, 0.1, 100.0);
   m.check_step_rad = p.get_in_range<double>("check_step_rad", m.check_step_rad, 0.001, 1.0);
   m.joint_speed_fraction = p.get_in_range<double>("joint_speed_fraction", m.joint_speed_fraction, 0.01, 1.0);
+  m.joint_accel_rad_s2 = p.get_in_range<double>("joint_accel_rad_s2", m.joint_accel_rad_s2, 0.01, 20.0);
   m.ik.track_iterations = p.get_in_range<int>("track_iterations", m.ik.track_iterations, 1, 50);
   // The palm flat 150 mm above the table, 150 mm to the side's side of the centre and 50 mm
   // nearer the robot, fingers forward (+y): where the hands work; found with ArmIk for the arms

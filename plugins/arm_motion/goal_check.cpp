@@ -14,6 +14,10 @@ ArmMotionReason check_goal(const ArmGoal& g, const GoalLimits& l) noexcept {
       g.point_count > ArmGoal::kMaxPoints || (g.stop_on != ArmGoal::stop_none && (g.stop_fingers & 0x1f) == 0)) {
     return ArmMotionReason::bad_points;
   }
+  if (g.interpolation != ArmGoal::cartesian &&
+      (g.interpolation != ArmGoal::joints || g.point_count != 1 || g.stop_on != ArmGoal::stop_none ||
+       g.frame == ArmGoal::measured))
+    return ArmMotionReason::bad_points;
   if (g.tool >= robot::kToolFrames) return ArmMotionReason::unknown_tool;
   const float lim[] = {g.speed_mm_s, g.accel_mm_s2, g.angular_speed_rad_s, g.angular_accel_rad_s2, g.stop_accel_mm_s2};
   for (float x : lim)

@@ -32,7 +32,8 @@ struct Workspace {
 };
 
 // ArmMotionReason::none when the goal's own content is acceptable, else the first reason found
-// in this order: bad_points (kind, frame, stop_on, point_count), unknown_tool, non_finite,
+// in this order: bad_points (kind, frame, stop_on, point_count; a joints goal: one point, no stop
+// condition, not in the measured frame), unknown_tool, non_finite,
 // bad_orientation, bad_limits. A stop goal is checked for its kind only.
 [[nodiscard]] ArmMotionReason check_goal(const ArmGoal& goal, const GoalLimits& limits) noexcept;
 

@@ -107,3 +107,22 @@ TEST_CASE("path_is_lift: straight up or steeper than 45 deg, orientation kept") 
   CHECK_FALSE(path_is_lift(path({{0, 0, 0}, {0, 0, NAN}})));
   CHECK_FALSE(path_is_lift(path({{0, 0, 0}})));                        // no motion
 }
+
+TEST_CASE("a joints goal: one point in the world or sheet frame, no stop condition; any other interpolation is bad") {
+  const GoalLimits l;
+  ArmGoal g = good();
+  g.interpolation = ArmGoal::joints;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);  // two points
+  g.point_count = 1;
+  CHECK(check_goal(g, l) == ArmMotionReason::none);
+  g.frame = ArmGoal::sheet;
+  CHECK(check_goal(g, l) == ArmMotionReason::none);
+  g.frame = ArmGoal::measured;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+  g.frame = ArmGoal::world;
+  g.stop_on = ArmGoal::contact_onset;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+  g.stop_on = ArmGoal::stop_none;
+  g.interpolation = 2;
+  CHECK(check_goal(g, l) == ArmMotionReason::bad_points);
+}
