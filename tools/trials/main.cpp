@@ -6,9 +6,10 @@
 // SEED + k (the sheet's pose on the table, its stiffness and yield, every friction, the
 // sensors' noise: sim_world's randomisation), the sequence started and followed to its end
 // (trial_run.h). Each trial leaves DIR/trial_<k>/: result.json, creased.log and creased's
-// report (report.html, .json, .txt). One row per trial as it ends, DIR/trials.json, and last
-// the summary line (trial_table.h). Exit status: 0 when every trial ran (whatever its
-// score), 1 when a trial could not run, 2 for bad arguments.
+// report (report.html, .json, .txt). One row per trial as it ends, DIR/trials.json, after the
+// last trial DIR/trials.html (trial_report.h), and last the summary line (trial_table.h). Exit
+// status: 0 when every trial ran (whatever its score), 1 when a trial could not run, 2 for bad
+// arguments.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -27,6 +28,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "tools/trials/trial_report.h"
 #include "tools/trials/trial_run.h"
 #include "tools/trials/trial_table.h"
 
@@ -186,6 +188,7 @@ int main(int argc, char** argv) {
   }
   std::sort(results.begin(), results.end(), [](const TrialResult& a, const TrialResult& b) { return a.index < b.index; });
   std::ofstream(fs::path(out) / "trials.json") << summary_json(results, o.fold, seed, faults).dump(1) << "\n";
+  std::ofstream(fs::path(out) / "trials.html") << trials_html(results, o.fold, faults);
   std::printf("%s\n", summary_line(results, o.fold, faults).c_str());
   return failed == 0 ? 0 : 1;
 }
