@@ -88,10 +88,19 @@ void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
   arm_move(side, m_.arm_tool[side], ArmGoal::measured, p, q, spec_.retreat, 0, out);
 }
 
-void Machine::arm_park(int side, Outbox& out) noexcept {
+void Machine::arm_park(int side, Outbox& out, bool joints) noexcept {
   const int s = side_of_role(spec_, side);  // park poses are per side
+  const int before = out.arm_count[side];
   arm_move(side, m_.arm_has_target[side] ? m_.arm_tool[side] : 0, ArmGoal::world, spec_.park_mm[s],
            spec_.park_orientation[s], spec_.retreat, 0, out);
+  if (joints && out.arm_count[side] > before) out.arm[side][before].interpolation = ArmGoal::joints;
+}
+
+bool Machine::joints_park_due(int s, const Sensing& in) const noexcept {
+  const ArmMotionStatus* a = in.arm[s];
+  if (m_.leaf != S::abort_park || m_.park_joints[s] || retreat_end(a, m_.arm_id[s]) != RetreatEnd::gave_up) return false;
+  const auto why = static_cast<ArmMotionReason>(a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason);
+  return why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed;
 }
 
 void Machine::pinch_as_laid(const double p[3], Outbox& out) noexcept {
@@ -165,6 +174,12 @@ void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
   if (m_.leaf != S::abort_lift && m_.leaf != S::abort_park) return;
   for (int s = 0; s < 2; ++s) {
     const ArmMotionStatus* a = in.arm[s];
+    if (joints_park_due(s, in)) {
+      m_.park_joints[s] = 1;
+      out.joints_park[s] = true;
+      arm_park(s, out, true);
+      continue;
+    }
     if (retreat_end(a, m_.arm_id[s]) != RetreatEnd::retry ||
         static_cast<double>(m_.last_ns - m_.arm_sent_ns[s]) * 1e-9 < kRetryS)
       continue;
@@ -177,7 +192,7 @@ void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
     const HandControlStatus* h = in.hand[s];
     if (h != nullptr && (h->mode == HandMode::retreat || h->inhibit != HandInhibit::none))
       hand_posture(s, spec_.open_rad, in, out);  // taken, it clears the latch that refuses the park
-    arm_park(s, out);
+    arm_park(s, out, m_.park_joints[s] != 0);
   }
 }
 
@@ -185,7 +200,8 @@ void Machine::report_retreat(const Sensing& in, Outbox& out) noexcept {
   if (m_.leaf != S::abort_lift && m_.leaf != S::abort_park) return;
   for (int s = 0; s < 2; ++s) {
     const ArmMotionStatus* a = in.arm[s];
-    if (m_.arm_id[s] == 0 || m_.gave_up_id[s] == m_.arm_id[s] || retreat_end(a, m_.arm_id[s]) != RetreatEnd::gave_up)
+    if (m_.arm_id[s] == 0 || m_.gave_up_id[s] == m_.arm_id[s] || retreat_end(a, m_.arm_id[s]) != RetreatEnd::gave_up ||
+        joints_park_due(s, in))
       continue;
     m_.gave_up_id[s] = m_.arm_id[s];
     out.gave_up[s] = a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason;
@@ -351,6 +367,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       break;
     case S::finish_park:
     case S::abort_park:
+      m_.park_joints[0] = m_.park_joints[1] = 0;
       arm_park(kFixing, out);
       arm_park(kPinching, out);
       break;

@@ -83,6 +83,10 @@ Status FoldSequencePlugin::update(const Cycle& c) {
                           : "retreat: the pinching arm's goal ended short (arm_motion reason), sent again",
              out.retried[r]);
   for (int r = 0; r < 2; ++r)
+    if (out.joints_park[r])
+      log_rt(rt::LogLevel::warn, r == kFixing ? "retreat: the fixing arm's park, out of reach on a line, sent in joint space"
+                                              : "retreat: the pinching arm's park, out of reach on a line, sent in joint space");
+  for (int r = 0; r < 2; ++r)
     if (out.gave_up[r] != Outbox::kNoRetry)
       log_rt(rt::LogLevel::warn,
              r == kFixing ? "retreat: the fixing arm's goal ended short for good (arm_motion reason)"

@@ -73,10 +73,12 @@ struct Outbox {
   static constexpr std::uint8_t kNoRetry = 0xff;
   std::uint8_t retried[2] = {kNoRetry, kNoRetry};
   std::uint8_t gave_up[2] = {kNoRetry, kNoRetry};  // ... or ended it for good, and why
+  bool joints_park[2] = {false, false};  // ... or sent the park again in joint space
   void clear() noexcept {
     arm_count[0] = arm_count[1] = hand_count[0] = hand_count[1] = 0;
     has_crease = has_memorize = overflow = false;
     retried[0] = retried[1] = gave_up[0] = gave_up[1] = kNoRetry;
+    joints_park[0] = joints_park[1] = false;
   }
 };
 
@@ -121,6 +123,7 @@ struct Memory {
   std::int64_t arm_sent_ns[2] = {0, 0};  // when the last move goal was sent
   std::uint32_t retreat_retries = 0;     // retreat goals sent again (retry_retreat)
   std::uint32_t gave_up_id[2] = {0, 0};  // the last retreat goal reported as ended for good
+  std::uint8_t park_joints[2] = {0, 0};  // the park was sent again in joint space (joints_park_due)
   double arm_target[2][3] = {};       // the last move goal's target (its frame)
   double arm_orientation[2][4] = {};
   std::uint32_t crease_count0 = 0;    // sheet_state's creases when the crease was sent
@@ -168,6 +171,9 @@ class Machine {
   // abort/lift, abort/park, each cycle before the rows: a retreat goal that ended for good is
   // reported once (Outbox::gave_up), since the arm stays where that left it.
   void report_retreat(const Sensing& in, Outbox& out) noexcept;
+  // abort/park: role S's park, a straight line there, was refused as out of reach (unreachable,
+  // joint_speed: a wrist the fold turned) and has not been sent in joint space yet (ArmGoal::joints).
+  [[nodiscard]] bool joints_park_due(int s, const Sensing& in) const noexcept;
   void arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                 const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;  // 0: no stop
   // One motion through the n points of path_mm (1..ArmGoal::kMaxPoints), the tool turned to
@@ -176,7 +182,7 @@ class Machine {
                 const double (*orientation)[4], const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;
   void arm_stop(int side, Outbox& out) noexcept;
   void arm_lift(int side, double lift_mm, Outbox& out) noexcept;
-  void arm_park(int side, Outbox& out) noexcept;
+  void arm_park(int side, Outbox& out, bool joints = false) noexcept;
   // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
   // pinch as the bend laid it (lay, withdraw).
   void pinch_as_laid(const double p[3], Outbox& out) noexcept;

@@ -433,8 +433,9 @@ TEST_CASE("the abort opens the hands again once lifted, before the park") {
 // for a moment (on a loaded machine the world fell behind, the arm's state went stale: the lift
 // aborted as arm_stale, the park was refused as arm_not_ready, and the retreat ended with a
 // hand 14 mm over the sheet): a lift or park that ended short for such a reason is sent again,
-// at most every kRetryS, until it is reached or the state times out. One refused for good
-// (unreachable) is not sent again. A park refused behind the hand's retreat opens it again first.
+// at most every kRetryS, until it is reached or the state times out. A park out of reach on a
+// line (unreachable) is sent once more in joint space; one refused for good after it is not sent
+// again. A park refused behind the hand's retreat opens it again first.
 TEST_CASE("the retreat sends a lift or park again that ended short for a reason that may pass") {
   using crease::fold::kRetryS;
   const auto moves_after = [](const Rig& r, long from) {
@@ -471,7 +472,26 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
       if (sent[k]->arm_goal.frame == sent[k - 1]->arm_goal.frame && sent[k]->arm_goal.kind == ArmGoal::move)
         CHECK(sent[k]->cycle - sent[k - 1]->cycle >= static_cast<long>(kRetryS * 1000));
   }
-  SUBCASE("a park refused as unreachable is not sent again: the retreat ends at once") {
+  SUBCASE("a park out of reach on a line is sent once in joint space, and reached so") {
+    Rig r;
+    const long abort_at = start_and_run_to(r, "fold/shift/press");
+    r.refuse_as = [&](int s, const ArmGoal& g, int) {
+      return s == kFix && g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian ? ArmMotionReason::unreachable
+                                                                                            : ArmMotionReason::none;
+    };
+    r.command(Command::abort);
+    REQUIRE(r.run_to("aborted", 20000));
+    const auto g = moves_after(r, abort_at);
+    REQUIRE(g.size() == 3);  // the lift, the park on a line (refused), the park in joint space
+    CHECK(g[1]->interpolation == ArmGoal::cartesian);
+    CHECK(g[2]->interpolation == ArmGoal::joints);
+    CHECK(g[2]->frame == ArmGoal::world);
+    CHECK(g[2]->position_mm[0][2] == 300.0);
+    const auto other = r.all(kPin, Sent::arm, abort_at);  // the pinching arm's park went on a line
+    REQUIRE(!other.empty());
+    CHECK(other.back()->arm_goal.interpolation == ArmGoal::cartesian);
+  }
+  SUBCASE("a park out of reach in joint space too is not sent again: the retreat ends at once") {
     Rig r;
     const long abort_at = start_and_run_to(r, "fold/shift/press");
     r.refuse_as = [&](int s, const ArmGoal& g, int) {
@@ -482,7 +502,7 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
     const long park_at = r.cycles();
     REQUIRE(r.run_to("aborted", 1000));
     CHECK(r.cycles() - park_at < static_cast<long>(kRetryS * 1000));
-    CHECK(moves_after(r, abort_at).size() == 2);  // the lift, the park
+    CHECK(moves_after(r, abort_at).size() == 3);  // the lift, the park on a line, in joint space
   }
   SUBCASE("a park refused behind the hand's retreat: the hand opened again, then the park") {
     Rig r;
