@@ -5,7 +5,7 @@
 // certainly not folded: the harness must say
 // so from the world's truth (a scorer that cannot fail is worthless), the retreat must leave
 // the hands clear of the sheet (the world's fingertips), and every row, the JSON summary, each
-// trial's report and the summary line must be there.
+// trial's report, the summary line and the HTML report with a plot per trial must be there.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -95,5 +96,13 @@ TEST_CASE("crease-trials: two short trials run, are scored from the world's trut
     CHECK(fs::exists(td / "creased.log"));
   }
   CHECK(draws[0] != draws[1]);  // each trial its own world
+  // The one report of every trial: a plot of each (the trials' series, from the world's truth).
+  std::ifstream html_in(dir / "trials.html");
+  const std::string html((std::istreambuf_iterator<char>(html_in)), std::istreambuf_iterator<char>());
+  CHECK(html.rfind("<!DOCTYPE html>", 0) == 0);
+  std::size_t plots = 0;
+  for (std::size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) ++plots;
+  CHECK(plots == 2);
+  for (int k = 0; k < 2; ++k) CHECK(j["trials"][k]["series"]["t_s"].size() > 100);  // 6 s at 50 Hz
   fs::remove_all(dir);
 }
