@@ -26,6 +26,8 @@ enum class Format { text, json, html };
 [[nodiscard]] std::string render_json(const TimingReport& report);  // pretty, 2-space indent
 [[nodiscard]] std::string render_html(const TimingReport& report);
 [[nodiscard]] std::string render(const TimingReport& report, Format format);
+// TEXT for HTML, element content and attribute values alike (& < > " ' as entities).
+[[nodiscard]] std::string html_escape(std::string_view text);
 
 // Writes DIR/BASENAME.{txt,json,html} (DIR created when missing) and returns the paths.
 // @throws crease::Error naming the file that could not be written.

@@ -8,9 +8,8 @@
 #include "core/report/render.h"
 
 namespace crease::report {
-namespace {
 
-std::string esc(const std::string& s) {
+std::string html_escape(std::string_view s) {
   std::string o;
   o.reserve(s.size());
   for (char c : s) {
@@ -25,6 +24,10 @@ std::string esc(const std::string& s) {
   }
   return o;
 }
+
+namespace {
+
+std::string esc(const std::string& s) { return html_escape(s); }
 
 std::string num(double v, int decimals = 1) {
   char buf[64];

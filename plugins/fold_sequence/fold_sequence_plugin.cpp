@@ -76,22 +76,7 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   if (out.has_crease) lost |= !crease_.try_push(out.crease);
   if (out.has_memorize) lost |= !memorize_.try_push(out.memorize);
   if (lost) machine_->fail(Reason::command_lost);
-  for (int r = 0; r < 2; ++r)
-    if (out.retried[r] != Outbox::kNoRetry)
-      log_rt(rt::LogLevel::warn,
-             r == kFixing ? "retreat: the fixing arm's goal ended short (arm_motion reason), sent again"
-                          : "retreat: the pinching arm's goal ended short (arm_motion reason), sent again",
-             out.retried[r]);
-  for (int r = 0; r < 2; ++r)
-    if (out.joints_park[r])
-      log_rt(rt::LogLevel::warn, r == kFixing ? "retreat: the fixing arm's park, out of reach on a line, sent in joint space"
-                                              : "retreat: the pinching arm's park, out of reach on a line, sent in joint space");
-  for (int r = 0; r < 2; ++r)
-    if (out.gave_up[r] != Outbox::kNoRetry)
-      log_rt(rt::LogLevel::warn,
-             r == kFixing ? "retreat: the fixing arm's goal ended short for good (arm_motion reason)"
-                          : "retreat: the pinching arm's goal ended short for good (arm_motion reason)",
-             out.gave_up[r]);
+  log_retreat(out);
 
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);
@@ -111,6 +96,39 @@ Status FoldSequencePlugin::update(const Cycle& c) {
     log_rt(rt::LogLevel::mark, text);
   }
   return status_value_.phase == SequenceStatus::aborted ? Status::degraded : Status::ok;
+}
+
+void FoldSequencePlugin::log_retreat(const Outbox& out) const noexcept {
+  // What the abort's retreat did to an arm's goal this cycle, per role (its text by role: the
+  // log takes no formatting in the loop).
+  struct Line {
+    bool happened;
+    const char* text[2];  // kFixing, kPinching
+    std::int64_t value;   // -1: none
+  };
+  for (int r = 0; r < 2; ++r) {
+    const Line lines[] = {
+        {out.retried[r] != Outbox::kNoRetry,
+         {"retreat: the fixing arm's goal ended short (arm_motion reason), sent again",
+          "retreat: the pinching arm's goal ended short (arm_motion reason), sent again"},
+         out.retried[r]},
+        {out.joints_park[r],
+         {"retreat: the fixing arm's park, out of reach on a line, sent in joint space",
+          "retreat: the pinching arm's park, out of reach on a line, sent in joint space"},
+         -1},
+        {out.gave_up[r] != Outbox::kNoRetry,
+         {"retreat: the fixing arm's goal ended short for good (arm_motion reason)",
+          "retreat: the pinching arm's goal ended short for good (arm_motion reason)"},
+         out.gave_up[r]},
+    };
+    for (const Line& l : lines) {
+      if (!l.happened) continue;
+      if (l.value >= 0)
+        log_rt(rt::LogLevel::warn, l.text[r], l.value);
+      else
+        log_rt(rt::LogLevel::warn, l.text[r]);
+    }
+  }
 }
 
 std::size_t FoldSequencePlugin::save_state(std::span<std::byte> out) const noexcept {

@@ -49,6 +49,8 @@ class FoldSequencePlugin final : public Plugin {
   [[nodiscard]] const FoldSpec& spec() const noexcept { return spec_; }
 
  private:
+  // RT. Logs what the abort's retreat did this cycle (Outbox's retried, joints_park, gave_up).
+  void log_retreat(const Outbox& out) const noexcept;
   FoldSpec spec_;
   std::unique_ptr<Machine> machine_;
   std::unique_ptr<Outbox> outbox_;

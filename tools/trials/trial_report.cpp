@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <string_view>
 
+#include "core/report/render.h"
 #include "tools/trials/trial_table.h"
 
 namespace crease::trials {
@@ -28,21 +29,7 @@ svg text{font-family:sans-serif;font-size:11px;fill:#333}svg text.band{pointer-e
 )";
 
 // Text for HTML (element content and attribute values alike).
-std::string esc(std::string_view s) {
-  std::string o;
-  o.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      case '\'': o += "&#39;"; break;
-      default: o += c;
-    }
-  }
-  return o;
-}
+std::string esc(std::string_view s) { return report::html_escape(s); }
 
 // A coordinate or a tick's value: never "nan" or "inf" in the page (a non-finite value is 0;
 // the plot's callers pass finite values only).
