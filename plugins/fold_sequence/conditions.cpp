@@ -86,6 +86,9 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
     case Ev::arms_reached: return reached(kFixing) && reached(kPinching);
     case Ev::arm_fix_contact: return contact_stop(kFixing);
     case Ev::arm_pin_contact: return contact_stop(kPinching);
+    // The descent's goal reached (its depth lies below the surface): nothing was touched.
+    case Ev::arm_fix_missed: return m_.arm_id[kFixing] != 0 && reached(kFixing);
+    case Ev::arm_pin_missed: return m_.arm_id[kPinching] != 0 && reached(kPinching);
     case Ev::hand_fix_settled: return settled(kFixing);
     case Ev::hand_pin_settled: return settled(kPinching);
     case Ev::hand_fix_posed: return m_.hand_id[kFixing] != 0 && posed(kFixing);

@@ -19,6 +19,8 @@ const char* event_name(Ev e) {
     case Ev::arms_reached: return "arms reached";
     case Ev::arm_fix_contact: return "fixing arm contact stop";
     case Ev::arm_pin_contact: return "pinching arm contact stop";
+    case Ev::arm_fix_missed: return "fixing arm at depth, no contact";
+    case Ev::arm_pin_missed: return "pinching arm at depth, no contact";
     case Ev::hand_fix_settled: return "fixing hand settled";
     case Ev::hand_pin_settled: return "pinching hand settled";
     case Ev::hand_fix_posed: return "fixing hand posed";

@@ -83,6 +83,7 @@ constexpr Row kRows[] = {
 
     {S::shift_approach, Ev::arm_fix_reached, Guard::fixing_armed, S::shift_contact, C, "fixing tool above the press point"},
     {S::shift_contact, Ev::arm_fix_contact, Guard::none, S::shift_press, C, "fixing hand touches the sheet"},
+    {S::shift_contact, Ev::arm_fix_missed, Guard::none, S::abort, Reason::no_contact, "no contact at the descent's depth"},
     {S::shift_press, Ev::hand_fix_settled, Guard::slide_too_long, S::abort, Reason::slide_out_of_range,
      "slide longer than max_slide_mm"},
     {S::shift_press, Ev::hand_fix_settled, Guard::slide_needed, S::shift_slide, C, "fixing force settled"},
@@ -109,6 +110,7 @@ constexpr Row kRows[] = {
     {S::refix_lift, Ev::arm_fix_reached, Guard::none, S::refix_approach, C, "fixing hand lifted"},
     {S::refix_approach, Ev::arm_fix_reached, Guard::fixing_armed, S::refix_contact, C, "fixing tool above both layers"},
     {S::refix_contact, Ev::arm_fix_contact, Guard::none, S::refix_press, C, "fixing hand touches both layers"},
+    {S::refix_contact, Ev::arm_fix_missed, Guard::none, S::abort, Reason::no_contact, "no contact at the descent's depth"},
     {S::refix_press, Ev::hand_fix_settled, Guard::none, S::swipe, C, "both layers fixated"},
 
     // Both layers fixated: the pinch lets go of the edge (the thumb opens) and its pads leave it.
@@ -118,6 +120,7 @@ constexpr Row kRows[] = {
     {S::swipe_lift, Ev::arm_pin_reached, Guard::none, S::swipe_approach, C, "pinching hand lifted"},
     {S::swipe_approach, Ev::arm_pin_reached, Guard::pinching_armed, S::swipe_contact, C, "pinching tool above the swipe"},
     {S::swipe_contact, Ev::arm_pin_contact, Guard::none, S::swipe_press, C, "pinching hand touches the fold"},
+    {S::swipe_contact, Ev::arm_pin_missed, Guard::none, S::abort, Reason::no_contact, "no contact at the descent's depth"},
     {S::swipe_press, Ev::hand_pin_settled, Guard::none, S::swipe_slide, C, "swipe force settled"},
     {S::swipe_slide, Ev::arm_pin_reached, Guard::none, S::harden, C, "swiped"},
 
@@ -125,6 +128,7 @@ constexpr Row kRows[] = {
     {S::harden_lift, Ev::arm_pin_reached, Guard::none, S::harden_approach, C, "pinching hand lifted"},
     {S::harden_approach, Ev::arm_pin_reached, Guard::pinching_armed, S::harden_contact, C, "pinching tool above the crease"},
     {S::harden_contact, Ev::arm_pin_contact, Guard::none, S::harden_press, C, "two fingers on the crease"},
+    {S::harden_contact, Ev::arm_pin_missed, Guard::none, S::abort, Reason::no_contact, "no contact at the descent's depth"},
     {S::harden_press, Ev::hand_pin_settled, Guard::none, S::harden_slide, C, "hardening force settled"},
     {S::harden_slide, Ev::arm_pin_reached, Guard::none, S::finish, C, "crease hardened"},
 
@@ -164,7 +168,7 @@ static_assert(rows_in_order(), "kRows are grouped by state in S's order");
 constexpr const char* kReasonNames[] = {
     "none",        "started",      "condition",      "timeout",        "device_fault",
     "vision_lost", "force_limit",  "unreachable",    "goal_refused",   "motion_aborted",
-    "slide_out_of_range", "no_sheet", "command_lost", "operator_abort",
+    "slide_out_of_range", "no_sheet", "command_lost", "operator_abort", "no_contact",
 };
 static_assert(sizeof(kReasonNames) / sizeof(kReasonNames[0]) == static_cast<std::size_t>(Reason::count));
 

@@ -46,6 +46,7 @@ enum class Ev : std::uint8_t {
   fault,          // a fault of the sensing (Reason says which); fold's rows only
   arm_fix_reached, arm_pin_reached, arms_reached,   // the state's arm goal(s) reached
   arm_fix_contact, arm_pin_contact,                 // stopped on a contact onset
+  arm_fix_missed, arm_pin_missed,                   // a contact descent reached its depth untouched
   hand_fix_settled, hand_pin_settled,               // force settled on the state's force goal
   hand_fix_posed, hand_pin_posed, hands_posed,      // the state's posture goal done
   pinched,        // the pinching hand's closing ended with the pinch fingers squeezing (force_n)
@@ -86,6 +87,7 @@ enum class Reason : std::uint8_t {
   no_sheet,          // a state needed the sheet's pose and there was none
   command_lost,      // a command queue was full
   operator_abort,
+  no_contact,        // a contact descent reached its depth (below the surface) without a contact
   count
 };
 [[nodiscard]] const char* reason_name(Reason r) noexcept;

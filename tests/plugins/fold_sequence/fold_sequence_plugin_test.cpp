@@ -385,6 +385,16 @@ TEST_CASE("faults abort with their reason; the retreat leaves both hands open") 
     CHECK(std::find(r.paths().begin(), r.paths().end(), "fold/shift/contact") == r.paths().end());
     expect_abort(r, Reason::device_fault);
   }
+  SUBCASE("no contact: a descent reaches its depth below the surface untouched") {
+    Rig r;
+    r.miss_contact[kFix] = true;
+    r.command(Command::start);
+    REQUIRE(r.run_to("fold/shift/contact"));
+    const long at = r.cycles();
+    expect_abort(r, Reason::no_contact);
+    CHECK(r.paths()[r.paths().size() - kRetreat.size() - 1] == "fold/shift/contact");
+    (void)at;
+  }
   SUBCASE("the operator's abort") {
     Rig r;
     start_and_run_to(r, "fold/swipe/slide");

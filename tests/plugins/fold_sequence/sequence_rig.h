@@ -187,6 +187,7 @@ class Rig {
   };
   HandInhibit inhibit[2] = {HandInhibit::none, HandInhibit::none};
   bool arm_fault[2] = {false, false};  // the running motion aborts with arm_fault
+  bool miss_contact[2] = {false, false};  // a contact descent reaches its depth, nothing touched
   bool refuse_hand_goals[2] = {false, false};  // every hand goal refused (inputs bad)
   // The pinch posture ends with th and ff squeezing (0.5 N each); false: the pads close on
   // nothing, though contact_state still names both (as a lagging ramp makes it do).
@@ -218,7 +219,7 @@ class Rig {
           a.st.state = ArmMotionStatus::aborted;
           a.st.reason = static_cast<std::uint8_t>(a.abort_as);
         } else if (!a.stall && --a.left <= 0) {
-          if (a.goal.stop_on == ArmGoal::contact_onset) {
+          if (a.goal.stop_on == ArmGoal::contact_onset && !miss_contact[s]) {
             a.st.state = ArmMotionStatus::stopped_on_contact;
             contact_[s].in_contact = 1;
             contact_[s].fingers = a.goal.stop_fingers;
