@@ -25,7 +25,7 @@ table{border-collapse:collapse;margin:8px 0;font-size:13px}
 td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eef}td.l,th.l{text-align:left}
 .yes{color:#070;font-weight:bold}.no{color:#a00}.none,.draws{color:#666;font-size:13px}
 svg{background:#fafafa;border:1px solid #ddd}
-svg text{font-family:sans-serif;font-size:11px;fill:#333}svg text.band{pointer-events:none}
+svg text{font-family:sans-serif;font-size:11px;fill:#333}.measured-r,.measured-l{stroke-dasharray:4 3}svg text.band{pointer-events:none}
 )";
 
 // Text for HTML (element content and attribute values alike).
@@ -180,6 +180,8 @@ std::string plot(const TrialResult& r) {
   for (const SeriesSample& x : r.series) {
     for (double v : x.force_n)
       if (std::isfinite(v)) force_max = std::max(force_max, v);
+    for (double v : x.measured_n)
+      if (std::isfinite(v)) force_max = std::max(force_max, v);
     if (std::isfinite(x.stretch)) stretch_max = std::max(stretch_max, 100 * x.stretch);
   }
   f.force_step = nice_step(force_max > 0 ? force_max : 1, 4);
@@ -196,7 +198,9 @@ std::string plot(const TrialResult& r) {
                  "stretch", kStretchColour);
   for (int h = 0; h < 2; ++h)
     s += polylines(decimate(r.series, [h](const SeriesSample& x) { return x.force_n[h]; }), f, f.force_top,
-                   h == 0 ? "force-r" : "force-l", kForceColour[h]);
+                   h == 0 ? "force-r" : "force-l", kForceColour[h]) +
+         polylines(decimate(r.series, [h](const SeriesSample& x) { return x.measured_n[h]; }), f, f.force_top,
+                   h == 0 ? "measured-r" : "measured-l", kForceColour[h]);
   return s + "</svg>\n";
 }
 
@@ -243,7 +247,8 @@ std::string trials_html(const std::vector<TrialResult>& results, const std::stri
                    "the tooltip). <span style=\"color:") +
        kForceColour[0] + "\">right hand</span> and <span style=\"color:" + kForceColour[1] +
        "\">left hand</span>: the largest fingertip normal force (N, left axis; each point the largest of its "
-       "window). <span style=\"color:" + kStretchColour +
+       "window), solid as the world has it, dashed as the hand's force controller measured it (its tactile sensors). "
+       "<span style=\"color:" + kStretchColour +
        "\">stretch</span>: the sheet's largest edge stretch (%, right axis), torn above " +
        num(100 * kTornStretch, 0) + " %.</p>\n";
   for (const TrialResult& r : results)

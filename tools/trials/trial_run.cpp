@@ -15,6 +15,7 @@
 
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
+#include "core/port_types/hand_control.h"
 #include "core/port_types/sequence_status.h"
 #include "core/port_types/sheet_state.h"
 #include "core/port_types/world_state.h"
@@ -75,13 +76,14 @@ std::string fold_instance(const config::DaemonConfig& cfg) {
   throw std::runtime_error("the configuration runs no fold_sequence");
 }
 
-std::string status_port(const config::DaemonConfig& cfg, const std::string& instance) {
+// The port INSTANCE's port KEY is bound to (KEY itself when not remapped).
+std::string port_of(const config::DaemonConfig& cfg, const std::string& instance, const std::string& key) {
   for (const auto& p : cfg.plugins)
     if (p.name == instance) {
-      const auto it = p.ports.find("sequence_status");
-      return it != p.ports.end() ? it->second : "sequence_status";
+      const auto it = p.ports.find(key);
+      return it != p.ports.end() ? it->second : key;
     }
-  return "sequence_status";
+  return key;
 }
 
 // The world's hands now: touching anything, their lowest fingertip.
@@ -139,7 +141,9 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     target.flap_corner_mm[0] = spec.corner_mm[0];
     target.flap_corner_mm[1] = spec.corner_mm[1];
     r.draws = describe_draws(cfg, seed);
-    const std::string status_name = status_port(cfg, fold);
+    const std::string status_name = port_of(cfg, fold, "sequence_status");
+    // The hands' force controllers' status, as the sequence reads it.
+    const std::string hand_status_name[2] = {port_of(cfg, fold, "hand_r_status"), port_of(cfg, fold, "hand_l_status")};
 
     daemon::Options opts;
     opts.plugin_dirs = o.plugin_dirs;
@@ -151,6 +155,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     PluginHost& host = d.host();
     auto status = reader<SequenceStatus>(host, status_name);
     auto world_state = reader<WorldState>(host, "world_state");
+    std::unique_ptr<rt::LatestReader<HandControlStatus>> hand_status[2] = {
+        reader<HandControlStatus>(host, hand_status_name[0]), reader<HandControlStatus>(host, hand_status_name[1])};
     auto truth = reader<SheetState>(host, "sheet_truth");
     auto reference = std::make_unique<SheetState>();
     bool have_reference = false;
@@ -163,6 +169,7 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
       host.set_param(fold, "command", 1.0);  // creasectl sequence start: taken when the guard passes
       std::int64_t started_ns = 0, ended_ns = 0, sampled_ns = 0;
       double window_force[2] = {0, 0};  // each hand's largest fingertip force since the last sample
+      double window_measured[2] = {std::nan(""), std::nan("")};  // ... as its force controller measured it
       std::uint32_t seen_transitions = 0;
       std::set<std::string> fold_states;
       bool operator_abort = false, grasp_reference = false;
@@ -181,11 +188,17 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
               window_force[h] = std::max(window_force[h], double(t.normal_force_n));
           for (int h = 0; h < 2; ++h) r.max_force_n[h] = std::max(r.max_force_n[h], window_force[h]);
         }
+        for (int h = 0; h < 2; ++h)
+          if (hand_status[h]->poll().has_data())
+            for (float f : hand_status[h]->value().force_n)
+              if (!(window_measured[h] >= f)) window_measured[h] = f;  // NaN (none yet) or less
         if (started_ns != 0 && rt::now_ns() - sampled_ns >= static_cast<std::int64_t>(kSeriesS * 1e9)) {
           sampled_ns = rt::now_ns();
           const double stretch = truth->poll().has_data() ? max_stretch(truth->value()) : std::nan("");
-          r.series.push_back({since(started_ns), {window_force[0], window_force[1]}, stretch});
+          r.series.push_back({since(started_ns), {window_force[0], window_force[1]}, stretch,
+                              {window_measured[0], window_measured[1]}});
           window_force[0] = window_force[1] = 0;
+          window_measured[0] = window_measured[1] = std::nan("");
         }
         if (started_ns == 0 && s.phase != SequenceStatus::idle) {
           started_ns = rt::now_ns();
@@ -305,12 +318,15 @@ nlohmann::json to_json(const TrialResult& r) {
   nlohmann::json timeline = nlohmann::json::array();
   for (const auto& e : r.timeline) timeline.push_back({{"t_s", e.t_s}, {"path", e.path}, {"why", e.why}});
   nlohmann::json series = {{"t_s", nlohmann::json::array()}, {"force_r_n", nlohmann::json::array()},
-                           {"force_l_n", nlohmann::json::array()}, {"stretch", nlohmann::json::array()}};
+                           {"force_l_n", nlohmann::json::array()}, {"stretch", nlohmann::json::array()},
+                           {"measured_r_n", nlohmann::json::array()}, {"measured_l_n", nlohmann::json::array()}};
   for (const auto& x : r.series) {
     series["t_s"].push_back(x.t_s);
     series["force_r_n"].push_back(num(x.force_n[0]));
     series["force_l_n"].push_back(num(x.force_n[1]));
     series["stretch"].push_back(num(x.stretch));
+    series["measured_r_n"].push_back(num(x.measured_n[0]));
+    series["measured_l_n"].push_back(num(x.measured_n[1]));
   }
   const Score& s = r.score;
   return {{"trial", r.index},
@@ -385,9 +401,13 @@ TrialResult from_json(const nlohmann::json& j) {
     r.timeline.push_back({e.at("t_s").get<double>(), e.at("path").get<std::string>(), e.at("why").get<std::string>()});
   if (j.contains("series")) {
     const auto& x = j.at("series");
-    for (std::size_t k = 0; k < x.at("t_s").size(); ++k)
-      r.series.push_back({x.at("t_s")[k].get<double>(), {num(x.at("force_r_n")[k]), num(x.at("force_l_n")[k])},
-                          num(x.at("stretch")[k])});
+    for (std::size_t k = 0; k < x.at("t_s").size(); ++k) {
+      SeriesSample v{x.at("t_s")[k].get<double>(), {num(x.at("force_r_n")[k]), num(x.at("force_l_n")[k])},
+                     num(x.at("stretch")[k])};
+      if (x.contains("measured_r_n")) v.measured_n[0] = num(x.at("measured_r_n")[k]);
+      if (x.contains("measured_l_n")) v.measured_n[1] = num(x.at("measured_l_n")[k]);
+      r.series.push_back(v);
+    }
   }
   r.error = j.at("error").get<std::string>();
   return r;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,10 @@ struct SeriesSample {
   double t_s = 0;              // since the sequence's start
   double force_n[2] = {0, 0};  // each hand's largest fingertip normal force (world_state) since the last sample
   double stretch = 0;          // the sheet's largest edge stretch (sheet_truth), NaN before one
+  // Each hand's largest fingertip force as its force controller measured it (its tactile
+  // sensors, hand_control_status) since the last sample, N; NaN without one. Beside force_n:
+  // the sensors' estimate against the world's truth.
+  double measured_n[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 inline constexpr double kSeriesS = 0.02;
 

@@ -258,6 +258,14 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(row(b).find("why=\"aborted in fold/shift/approach: device_fault; sheet: no fold") != std::string::npos);
   CHECK(row(a).find("success=1") != std::string::npos);
   // The JSON round trip keeps what the table shows.
+  b.series.push_back({0.5, {1.5, 2.0}, 0.02, {1.4, std::nan("")}});
   const TrialResult back = from_json(to_json(b));
   CHECK(row(back) == row(b));
+  // ... and the series: the world's forces, the stretch, the sensors' forces (NaN: none yet).
+  REQUIRE(back.series.size() == 1);
+  CHECK(back.series[0].t_s == 0.5);
+  CHECK(back.series[0].force_n[1] == 2.0);
+  CHECK(back.series[0].stretch == 0.02);
+  CHECK(back.series[0].measured_n[0] == 1.4);
+  CHECK(std::isnan(back.series[0].measured_n[1]));
 }
