@@ -73,13 +73,18 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
   // PST: pressure above the tare, which follows the sensor while the finger touches nothing.
   // While pressed, the electronics' high-pass (time constant pst_highpass_s) bleeds a held
   // pressure away: x = y + (1/tau) integral y dt undoes it.
+  // A cycle without a sample of a sensor (its frame did not come in this cycle: pressure_valid
+  // is per cycle) holds that finger's force as last measured, and the next sample covers the
+  // time since its last one: no sample is no force (a reading of 0 N mid-press made the force
+  // loop push and reset its settling, on a loaded machine every few cycles). A hand_state gone
+  // stale altogether is check_inputs_rt's: force stops being added.
   const bool contact = contact_fresh(in, c_.max_contact_age_ns);
-  const double a = std::min(1.0, in.dt_s / c_.baseline_time_constant_s);
   for (int f = 0; f < kFingers; ++f) {
-    if ((in.hand->pressure_valid & (1u << f)) == 0) {
-      f_[sz(f)] = 0;
-      continue;
-    }
+    s_.pst_gap_s[sz(f)] += in.dt_s;
+    if ((in.hand->pressure_valid & (1u << f)) == 0) continue;
+    const double dt = s_.pst_gap_s[sz(f)];
+    s_.pst_gap_s[sz(f)] = 0;
+    const double a = std::min(1.0, dt / c_.baseline_time_constant_s);
     const double p = in.hand->pressure_kpa[f];
     const bool pressed = (s_.mode == HandMode::force && (s_.fingers & (1u << f)) != 0) ||
                          (contact && (in.contact->fingers & (1u << f)) != 0);
@@ -88,7 +93,7 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
       s_.baseline_kpa[sz(f)] += a * (p - s_.baseline_kpa[sz(f)]);
       s_.highpass_kpa[sz(f)] = 0;
     } else if (c_.pst_highpass_s > 0) {
-      s_.highpass_kpa[sz(f)] += above * in.dt_s / c_.pst_highpass_s;
+      s_.highpass_kpa[sz(f)] += above * dt / c_.pst_highpass_s;
     }
     f_[sz(f)] = std::max(0.0, (above + s_.highpass_kpa[sz(f)]) / c_.kpa_per_n);
   }
