@@ -24,12 +24,19 @@ bool ContactDetector::tactile_healthy(const ContactInputs& in) const noexcept {
 }
 
 void ContactDetector::pressures(const ContactInputs& in, std::array<double, kFingers>& kpa,
-                                std::uint8_t& valid) const noexcept {
+                                std::uint8_t& valid) noexcept {
   kpa.fill(0.0);
   valid = 0;
   if (c_.tactile == TactileSource::pst && in.hand != nullptr) {
-    for (int f = 0; f < kFingers; ++f) kpa[static_cast<std::size_t>(f)] = in.hand->pressure_kpa[f];
-    valid = in.hand->pressure_valid;
+    for (int f = 0; f < kFingers; ++f) {
+      const auto fs = static_cast<std::size_t>(f);
+      if ((in.hand->pressure_valid & (1u << f)) != 0) {
+        s_.last_kpa[fs] = in.hand->pressure_kpa[f];
+        s_.kpa_seen = static_cast<std::uint8_t>(s_.kpa_seen | (1u << f));
+      }
+      kpa[fs] = s_.last_kpa[fs];
+    }
+    valid = s_.kpa_seen;
   } else if (c_.tactile == TactileSource::taxels && in.tactile != nullptr) {
     for (int f = 0; f < kFingers; ++f) {
       double sum = 0;

@@ -79,6 +79,8 @@ class ContactDetector {
   struct State {
     std::array<float, kJoints> theta_ref{}, target_ref{}, window_theta{}, window_target{};
     std::array<double, kFingers> baseline_kpa{}, window_sum_kpa{};
+    std::array<double, kFingers> last_kpa{};  // each PST sensor's last sample (hand_state's come per cycle)
+    std::uint8_t kpa_seen = 0;                // bit f: sensor f has sent a sample
     std::array<double, kJoints> window_sum_rad{}, window_sum2_rad{};  // of theta - window_theta
     double enter_rad = 0, exit_rad = 0;  // the thresholds in use (set when it arms)
     double noise_rad = 0;                // the joints' noise measured when it armed
@@ -106,7 +108,11 @@ class ContactDetector {
  private:
   [[nodiscard]] bool hand_healthy_rt(const ContactInputs& in) noexcept;
   [[nodiscard]] bool tactile_healthy(const ContactInputs& in) const noexcept;
-  void pressures(const ContactInputs& in, std::array<double, kFingers>& kpa, std::uint8_t& valid) const noexcept;
+  // The fingertips' pressures this cycle. A PST sensor without a sample this cycle
+  // (pressure_valid is per cycle: its frame did not come in) reads as its last sample: no sample
+  // is not no pressure (it broke the tactile test's run, so a press whose frames came every
+  // other cycle never debounced into a contact).
+  void pressures(const ContactInputs& in, std::array<double, kFingers>& kpa, std::uint8_t& valid) noexcept;
   void settle_rt(const ContactInputs& in, const std::array<double, kFingers>& kpa) noexcept;
 
   ContactConfig c_;

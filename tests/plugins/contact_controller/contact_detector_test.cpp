@@ -230,6 +230,30 @@ TEST_CASE("tactile contact OR'ed with the joints: a PST pressure above its tared
   }
 }
 
+// hand_state's pressure_valid is per cycle: a cycle whose pressure frame did not come in has
+// none. The sensor then reads as its last sample, so a press whose frames come every other
+// cycle still debounces into a contact (failing variant, a missing sample read as no
+// pressure: the tactile test's run restarts every other cycle and never reaches the debounce).
+TEST_CASE("a cycle without a PST sample reads as the last one: a press with every other sample missing is a contact") {
+  Rig r(config("{tactile: pst, tactile_enter_kpa: 0.03, tactile_exit_kpa: 0.015}"));
+  r.arm();
+  r.hand.pressure_kpa[2] = 0.25f;
+  for (int i = 0; i < 20; ++i) {
+    r.hand.pressure_valid = i % 2 == 0 ? 0x1F : 0x00;
+    r.step();
+  }
+  CHECK(r.out.in_contact == 1);
+  CHECK(r.out.fingers == 0b00100);
+  CHECK(r.onsets() == 1);
+  // Released: the samples that come read the baseline again, and the contact ends.
+  r.hand.pressure_kpa[2] = 0.2f;
+  for (int i = 0; i < 20; ++i) {
+    r.hand.pressure_valid = i % 2 == 0 ? 0x1F : 0x00;
+    r.step();
+  }
+  CHECK(r.out.in_contact == 0);
+}
+
 TEST_CASE("the baseline follows a slow drift of untouched sensors (failing variant: a baseline that does not follow)") {
   for (const double tau : {1.0, 1e4}) {
     CAPTURE(tau);
