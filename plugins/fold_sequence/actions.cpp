@@ -99,7 +99,7 @@ void Machine::arm_park(int side, Outbox& out, bool joints) noexcept {
 bool Machine::joints_park_due(int s, const Sensing& in) const noexcept {
   const ArmMotionStatus* a = in.arm[s];
   if (m_.leaf != S::abort_park || m_.park_joints[s] || retreat_end(a, m_.arm_id[s]) != RetreatEnd::gave_up) return false;
-  const auto why = static_cast<ArmMotionReason>(a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason);
+  const auto why = static_cast<ArmMotionReason>(end_reason(*a, m_.arm_id[s]));
   return why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed;
 }
 
@@ -183,8 +183,7 @@ void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
     if (retreat_end(a, m_.arm_id[s]) != RetreatEnd::retry ||
         static_cast<double>(m_.last_ns - m_.arm_sent_ns[s]) * 1e-9 < kRetryS)
       continue;
-    out.retried[s] = a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason;
-    ++m_.retreat_retries;
+    out.retried[s] = end_reason(*a, m_.arm_id[s]);
     if (m_.leaf == S::abort_lift) {
       arm_lift(s, spec_.release_lift_mm, out);  // from where it is now: up again
       continue;
@@ -204,7 +203,7 @@ void Machine::report_retreat(const Sensing& in, Outbox& out) noexcept {
         joints_park_due(s, in))
       continue;
     m_.gave_up_id[s] = m_.arm_id[s];
-    out.gave_up[s] = a->last_refused_id == m_.arm_id[s] ? a->last_refusal : a->reason;
+    out.gave_up[s] = end_reason(*a, m_.arm_id[s]);
   }
 }
 

@@ -206,7 +206,7 @@ Reason Machine::fault(const Sensing& in) noexcept {
     if (id == 0) continue;
     if (a->last_refused_id == id || (a->goal_id == id && (a->state == ArmMotionStatus::unreachable ||
                                                           a->state == ArmMotionStatus::refused))) {
-      const auto why = static_cast<ArmMotionReason>(a->last_refused_id == id ? a->last_refusal : a->reason);
+      const auto why = static_cast<ArmMotionReason>(end_reason(*a, id));
       return why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed ? Reason::unreachable
                                                                                          : Reason::goal_refused;
     }

@@ -45,6 +45,11 @@ inline constexpr int kPinching = 1;
 // busy): sent again.
 enum class RetreatEnd : std::uint8_t { pending, reached, gave_up, retry };
 [[nodiscard]] RetreatEnd retreat_end(const ArmMotionStatus* a, std::uint32_t id) noexcept;
+// Why arm_motion ended goal ID (an ArmMotionReason): its refusal when it was refused, else the
+// reason on the status. A is not null.
+[[nodiscard]] inline std::uint8_t end_reason(const ArmMotionStatus& a, std::uint32_t id) noexcept {
+  return a.last_refused_id == id ? a.last_refusal : a.reason;
+}
 inline constexpr double kRetryS = 0.1;  // a retreat goal sent again at most this often
 
 // One cycle's sensing; a null pointer: never written. Timestamps are compared with now_ns.
@@ -87,7 +92,7 @@ enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, 
 struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
-  // retreat's retries (arm_sent_ns, retreat_retries)
+  // retreat's retries (arm_sent_ns, gave_up_id, park_joints)
   static constexpr std::uint32_t kVersion = 4;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
@@ -121,7 +126,6 @@ struct Memory {
   std::uint8_t arm_frame[2] = {0, 0};
   std::uint8_t arm_tool[2] = {0, 0};
   std::int64_t arm_sent_ns[2] = {0, 0};  // when the last move goal was sent
-  std::uint32_t retreat_retries = 0;     // retreat goals sent again (retry_retreat)
   std::uint32_t gave_up_id[2] = {0, 0};  // the last retreat goal reported as ended for good
   std::uint8_t park_joints[2] = {0, 0};  // the park was sent again in joint space (joints_park_due)
   double arm_target[2][3] = {};       // the last move goal's target (its frame)

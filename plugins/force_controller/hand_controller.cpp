@@ -75,7 +75,7 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
   // pressure away: x = y + (1/tau) integral y dt undoes it.
   // A cycle without a sample of a sensor (its frame did not come in this cycle: pressure_valid
   // is per cycle) holds that finger's force as last measured, and the next sample covers the
-  // time since its last one: no sample is no force (a reading of 0 N mid-press made the force
+  // time since its last one: no sample is not no force (a reading of 0 N mid-press made the force
   // loop push and reset its settling, on a loaded machine every few cycles). A hand_state gone
   // stale altogether is check_inputs_rt's: force stops being added.
   const bool contact = contact_fresh(in, c_.max_contact_age_ns);
