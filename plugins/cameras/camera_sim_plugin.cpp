@@ -3,7 +3,9 @@
 // channel. It renders nothing but that sheet: until the port has a value the cameras see the
 // empty table, and each frame is stamped with the time of the truth it shows.
 // Parameters: cameras: DIR (cam0.yaml..), layout: layout.yaml, seed, noise, blur_px, occluders,
-// frame_period_s (the stamp of frames rendered before the first truth); and camera_plugin.h's.
+// frame_period_s (the stamp of frames rendered before the first truth); dropouts, dropout_frames,
+// dropout_from_frame, dropout_to_frame, dropout_seed (cameras that deliver nothing for a run of
+// frame sets: sim_source.h); and camera_plugin.h's.
 // Inputs: sheet_truth (crease::SheetState). Outputs: images (frames), frames (CameraFrames).
 #include <memory>
 
@@ -28,9 +30,18 @@ class CameraSimPlugin final : public CameraPlugin {
         face_texture(layout, Face::kFront, ppm), face_texture(layout, Face::kBack, ppm), ppm, cams);
     const RenderOptions ro = read_render_options(p);
     const double period_s = p.get_in_range<double>("frame_period_s", 1.0 / 30, 1e-3, 10.0);
+    // Camera dropouts (crease-trials --faults): `dropouts` of `dropout_frames` frame sets each.
+    const int dropouts = p.get_in_range<int>("dropouts", 0, 0, 100);
+    const auto dropout_frames = static_cast<std::uint64_t>(p.get_in_range<int>("dropout_frames", 8, 1, 100000));
+    const auto from = static_cast<std::uint64_t>(p.get_in_range<int>("dropout_from_frame", 30, 0, 100000000));
+    const auto to = static_cast<std::uint64_t>(
+        p.get_in_range<int>("dropout_to_frame", 450, static_cast<int>(from), 100000000));
+    const auto dropout_seed = static_cast<std::uint64_t>(
+        p.get_in_range<long long>("dropout_seed", static_cast<long long>(ro.seed), 0, (1LL << 62)));
+    auto drops = draw_dropouts(dropout_seed, dropouts, dropout_frames, from, to, static_cast<int>(cams.size()));
     truth_.bind(ports);
-    auto src = std::make_unique<SimSource>(
-        renderer, truth_.mesh_source(), ro, static_cast<std::int64_t>(period_s * 1e9), crease::rt::now_ns());
+    auto src = std::make_unique<SimSource>(renderer, truth_.mesh_source(), ro, static_cast<std::int64_t>(period_s * 1e9),
+                                           crease::rt::now_ns(), std::move(drops));
     configure_camera(p, ports, std::move(src));
   }
 

@@ -24,6 +24,7 @@
 #include "core/port_types/world_state.h"
 #include "drivers/host/bus_prefix.h"
 #include "plugins/robot_model/robot_model.h"
+#include "plugins/sim_world/bus_faults.h"
 #include "plugins/sim_world/randomise.h"
 #include "plugins/sim_world/sim_world.h"
 #include "plugins/sim_world/world_config.h"
@@ -66,19 +67,24 @@ class SimWorldPlugin final : public Plugin {
     } catch (const std::exception& e) {
       p.fail("tactile_link", e.what());
     }
+    if (cfg_.faults) {
+      faults_ = std::make_unique<wd::BusFaultInjector>(devices_->robot(), wd::draw_bus_faults(cfg_.bus_faults));
+      log_lines(wd::describe(faults_->plan()));
+    }
     full_ = std::make_unique<SheetState>();
     if (cfg_.truth_stride > 1) truth_ = std::make_unique<SheetState>();
     state_ = std::make_unique<WorldState>();
     world_out_ = ports.latest_output<WorldState>("world_state", WorldState{});
     const auto no_sheet = std::make_unique<SheetState>();  // the safe value: no sheet (0 x 0 nodes)
     sheet_out_ = ports.latest_output<SheetState>("sheet_truth", *no_sheet);
-    log_draws();
+    log_lines(wd::describe(cfg_.world.seed, world_->draws()));
   }
 
   void activate() override { steps_ = 0; }
 
   Status update(const Cycle& cycle) override {
     devices_->step_rt();
+    if (faults_) faults_->tick_rt(world_->state().time_s);
     tactile_->step_rt(world_->state(), cfg_.world.dt_s, devices_->robot(), devices_->device_time_ns());
     *state_ = world_->state();
     state_->timestamp_ns = cycle.time_ns;  // the port's stamp: the loop's clock
@@ -88,6 +94,7 @@ class SimWorldPlugin final : public Plugin {
   }
 
   void cleanup() override {
+    faults_.reset();  // before the buses it injects into
     tactile_.reset();
     devices_.reset();  // the devices and their buses first: they reference the world
     world_.reset();
@@ -126,14 +133,15 @@ class SimWorldPlugin final : public Plugin {
     sheet_out_.write(t, now_ns);
   }
 
-  // The seed and its draws, in lines the RT log carries (96 characters each).
-  void log_draws() const {
-    const std::string line = wd::describe(cfg_.world.seed, world_->draws());
+  // A long line (the world's draws, the buses' faults) in lines the RT log carries (96
+  // characters each), cut after a comma or semicolon.
+  void log_lines(const std::string& line) const {
     std::size_t at = 0;
     while (at < line.size()) {
       std::size_t n = std::min<std::size_t>(90, line.size() - at);
       if (at + n < line.size()) {
-        const std::size_t cut = line.rfind(", ", at + n);
+        const std::size_t comma = line.rfind(", ", at + n), semi = line.rfind("; ", at + n);
+        const std::size_t cut = comma == std::string::npos ? semi : (semi == std::string::npos ? comma : std::max(comma, semi));
         if (cut != std::string::npos && cut > at) n = cut + 2 - at;
       }
       log_rt(rt::LogLevel::info, line.substr(at, n).c_str());
@@ -146,6 +154,7 @@ class SimWorldPlugin final : public Plugin {
   std::unique_ptr<wd::World> world_;
   std::unique_ptr<wd::WorldDevices> devices_;
   std::unique_ptr<wd::WorldTactile> tactile_;
+  std::unique_ptr<wd::BusFaultInjector> faults_;  // faults: true
   std::unique_ptr<SheetState> full_, truth_;
   std::unique_ptr<WorldState> state_;
   LatestOutput<WorldState> world_out_;

@@ -103,6 +103,17 @@ WorldPluginConfig read_world_config(const Params& p) {
   } else if (!drivers::valid_link_name(c.tactile_link)) {
     p.fail("tactile_link", "must be 1..32 of [A-Za-z0-9._-], or none");
   }
+  c.faults = p.get<bool>("faults", false);
+  BusFaultConfig& f = c.bus_faults;
+  f.seed = static_cast<std::uint64_t>(p.get_in_range<long long>("fault_seed", static_cast<long long>(w.seed), 0, (1LL << 62)));
+  f.drop = p.get_in_range<double>("fault_drop", f.drop, 0.0, 0.5);
+  f.corrupt = p.get_in_range<double>("fault_corrupt", f.corrupt, 0.0, 0.5);
+  f.delay_ms = p.get_in_range<double>("fault_delay_ms", f.delay_ms, 0.0, 1000.0);
+  f.delay_burst_s = p.get_in_range<double>("fault_delay_burst_s", f.delay_burst_s, 0.0, 60.0);
+  f.bus_off = p.get<bool>("fault_bus_off", f.bus_off);
+  f.host_node = static_cast<std::uint32_t>(p.get_in_range<int>("fault_host_node", static_cast<int>(f.host_node), 0, 100000));
+  f.from_s = p.get_in_range<double>("fault_from_s", f.from_s, 0.0, 1e6);
+  f.to_s = p.get_in_range<double>("fault_to_s", f.to_s, f.from_s, 1e6);
   return c;
 }
 

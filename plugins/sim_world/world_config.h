@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/params.h"
+#include "plugins/sim_world/bus_fault_plan.h"
 #include "plugins/sim_world/world_params.h"
 
 namespace crease::world {
@@ -25,6 +26,11 @@ struct WorldPluginConfig {
   // this) (drivers/host/bus_prefix.h) for hand_driver's `tactile_device: tactile_r`; empty
   // (`none`): no link.
   std::string tactile_link = "tactile_r";
+  // `faults: true`: the buses' faults of bus_faults.h, drawn from the world's seed unless
+  // `fault_seed` says otherwise (`fault_drop`, `fault_corrupt`, `fault_delay_ms`,
+  // `fault_delay_burst_s`, `fault_bus_off`, `fault_host_node`, `fault_from_s`, `fault_to_s`).
+  bool faults = false;
+  BusFaultConfig bus_faults;
 };
 
 // Throws crease::ConfigError naming file, line and key.

@@ -90,17 +90,14 @@ int main(int argc, char** argv) {
   app.add_option("--retain-s", o.retain_s, "after a finished fold, the retained angle is scored this much later")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_flag("--faults", faults, "bus faults and camera dropouts (not available yet)");
+  app.add_flag("--faults", faults, "bus faults (drops, corruption, a delay burst, a hand's bus-off) and camera dropouts");
   app.add_option("--log-level", log_level, "each trial's creased.log: trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
   app.add_option("--child-trial", child_trial, "(internal) run trial K in this process")->group("");
   app.add_option("--child-seed", child_seed, "(internal) its seed")->group("");
   CLI11_PARSE(app, argc, argv);
-  if (faults) {
-    std::fprintf(stderr, "crease-trials: --faults: fault injection (bus faults, camera dropouts) is not available yet\n");
-    return 2;
-  }
+  o.faults = faults;
   o.config = fs::absolute(o.config).string();
   for (auto& d : o.plugin_dirs) d = fs::absolute(d).string();
   out = fs::absolute(out).string();
@@ -124,6 +121,7 @@ int main(int argc, char** argv) {
                                      out,             "--config",      o.config,           "--max-fold-s",
                                      std::to_string(o.max_fold_s),     "--retain-s",       std::to_string(o.retain_s),
                                      "--log-level",   log_level};
+    if (o.faults) args.emplace_back("--faults");
     for (const auto& d : o.plugin_dirs) {
       args.emplace_back("--plugin-dir");
       args.push_back(d);

@@ -22,6 +22,7 @@
 #include "plugins/fold_sequence/fold_spec.h"
 #include "plugins/fold_sequence/states.h"
 #include "plugins/robot_model/robot_params.h"
+#include "plugins/sim_world/bus_fault_plan.h"
 #include "plugins/sim_world/randomise.h"
 #include "rt/clock.h"
 #include "rt/latest.h"
@@ -59,7 +60,20 @@ std::string describe_draws(const config::DaemonConfig& cfg, std::uint64_t seed) 
     num("yield_fraction", w.yield_fraction);
     num("friction_fraction", w.friction_fraction);
     const fs::path robot = fs::path(cfg.file).parent_path() / n["robot"].as<std::string>();
-    return world::describe(seed, world::draw_world(w, robot::load_robot_params(robot.string())));
+    std::string out = world::describe(seed, world::draw_world(w, robot::load_robot_params(robot.string())));
+    if (n["faults"] && n["faults"].as<bool>()) {  // as world_config.cpp reads them
+      world::BusFaultConfig f;
+      f.seed = n["fault_seed"] ? n["fault_seed"].as<std::uint64_t>() : seed;
+      num("fault_drop", f.drop);
+      num("fault_corrupt", f.corrupt);
+      num("fault_delay_ms", f.delay_ms);
+      num("fault_delay_burst_s", f.delay_burst_s);
+      num("fault_from_s", f.from_s);
+      num("fault_to_s", f.to_s);
+      if (n["fault_bus_off"]) f.bus_off = n["fault_bus_off"].as<bool>();
+      out += "; " + world::describe(world::draw_bus_faults(f));
+    }
+    return out;
   }
   return "no sim_world instance";
 }
@@ -101,6 +115,21 @@ void hands_now(const WorldState& w, bool& touching, double& min_z) {
 
 }  // namespace
 
+void enable_faults(config::DaemonConfig& cfg, std::uint64_t seed) {
+  int worlds = 0;
+  for (const auto& p : cfg.plugins) {
+    if (p.library == "sim_world") {
+      config::override_param(cfg, p.name + ".faults=true");
+      config::override_param(cfg, p.name + ".fault_seed=" + std::to_string(seed));
+      ++worlds;
+    } else if (p.library == "camera_sim") {
+      config::override_param(cfg, p.name + ".dropouts=3");
+      config::override_param(cfg, p.name + ".dropout_seed=" + std::to_string(seed));
+    }
+  }
+  if (worlds == 0) throw std::runtime_error("--faults: the configuration runs no sim_world (whose buses get the faults)");
+}
+
 void judge(TrialResult& r) {
   r.success = false;
   if (!r.error.empty()) {
@@ -134,6 +163,7 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     const std::string fold_file = "folds/" + o.fold + ".yaml";
     config::override_param(cfg, world + ".seed=" + std::to_string(seed));
     config::override_param(cfg, fold + ".fold=" + fold_file);
+    if (o.faults) enable_faults(cfg, seed);
     const fold::FoldSpec spec = fold::load_fold_file((fs::path(cfg.file).parent_path() / fold_file).string());
     FoldTarget target;
     for (int k = 0; k < 2; ++k)

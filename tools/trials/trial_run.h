@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/config/daemon_config.h"
 #include "tools/trials/trial_score.h"
 
 namespace crease::trials {
@@ -27,8 +28,15 @@ struct TrialOptions {
   double ready_timeout_s = 60;           // the start waits for its guard at most this long
   double retain_s = 5;                   // after done (the hands released): then the retained angle
   std::string dir;                       // the trial's directory: its report, log, socket
+  // --faults: the world's bus faults (plugins/sim_world/bus_faults.h) and camera dropouts
+  // (camera_sim's `dropouts`), drawn from the trial's seed.
+  bool faults = false;
   Bounds bounds;
 };
+
+// --faults: the trial's configuration with the faults on (every sim_world instance's `faults`,
+// every camera_sim instance's `dropouts`, seeded by SEED). Throws when neither is present.
+void enable_faults(config::DaemonConfig& cfg, std::uint64_t seed);
 
 struct TimelineEntry {
   double t_s = 0;  // since the sequence's start

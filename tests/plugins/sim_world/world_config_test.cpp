@@ -61,3 +61,19 @@ TEST_CASE("sheet_turn_deg turns the world's sheet grid; out of range it names fi
   CHECK(e.find("sim.yaml:2") != std::string::npos);
   CHECK(e.find("sheet_turn_deg") != std::string::npos);
 }
+
+TEST_CASE("faults: off unless asked; drawn from the world's seed unless fault_seed says; out of range names file, line and key") {
+  CHECK_FALSE(read("").faults);
+  const auto on = read("seed: 9\nfaults: true\nfault_drop: 0.01\nfault_bus_off: false\n");
+  CHECK(on.faults);
+  CHECK(on.bus_faults.seed == 9);
+  CHECK(on.bus_faults.drop == doctest::Approx(0.01));
+  CHECK_FALSE(on.bus_faults.bus_off);
+  CHECK(read("seed: 9\nfaults: true\nfault_seed: 4\n").bus_faults.seed == 4);
+  for (const char* bad : {"fault_drop: 2\n", "fault_delay_ms: -1\n", "fault_from_s: 10\nfault_to_s: 5\n", "faults: maybe\n"}) {
+    const std::string e = error_of(bad);
+    INFO(bad << " -> " << e);
+    CHECK(e.find("sim.yaml:") != std::string::npos);
+    CHECK(e.find("fault") != std::string::npos);
+  }
+}

@@ -99,3 +99,28 @@ TEST_CASE("a SheetState's sheet becomes the mesh; a state never written gives no
   CHECK(sheet_pixels(view) > 10000);
   CHECK(cv::countNonZero(view.occluder_mask) > 0);
 }
+
+TEST_CASE("a camera dropout delivers nothing for its frames, and only for them; the draws are the seed's") {
+  const testing::Scene s;
+  SimSource src(
+      one_camera(s), [&](std::uint64_t) { return s.flat(); }, RenderOptions{}, 1'000, 0, {{0, 2, 3}});
+  for (std::uint64_t i = 0; i < 7; ++i) {
+    Frame f;
+    REQUIRE(src.grab(f));
+    REQUIRE(f.images.size() == 1);
+    INFO("frame " << i);
+    CHECK(f.images[0].empty() == (i >= 2 && i < 5));
+  }
+  const auto a = draw_dropouts(4, 3, 8, 30, 450, 5), b = draw_dropouts(4, 3, 8, 30, 450, 5);
+  REQUIRE(a.size() == 3);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    CHECK(a[k].camera == b[k].camera);
+    CHECK(a[k].first_frame == b[k].first_frame);
+    CHECK(a[k].camera >= 0);
+    CHECK(a[k].camera < 5);
+    CHECK(a[k].first_frame >= 30);
+    CHECK(a[k].first_frame <= 450);
+    CHECK(a[k].frames == 8);
+  }
+  CHECK(draw_dropouts(4, 0, 8, 30, 450, 5).empty());
+}
