@@ -20,10 +20,14 @@ bool CanDeviceHost::begin_write() noexcept {
   ++cycle_;
   batch_len_ = 0;
   if (bus_.state() == BusState::bus_off) {
-    if (cycle_ % static_cast<std::uint64_t>(restart_period_cycles_) == 1) bus_.restart();
+    // The first cycle that finds the bus off restarts it (as SocketCAN's restart-ms does after
+    // its delay), then every restart_period_cycles while it stays off.
+    if (bus_off_cycles_ % static_cast<std::uint64_t>(restart_period_cycles_) == 0) bus_.restart();
+    ++bus_off_cycles_;
     safe_sent_ = true;
     return false;
   }
+  bus_off_cycles_ = 0;
   if (!operational_ && cycle_ % static_cast<std::uint64_t>(nmt_retry_cycles_) == 1) {
     add(canopen::encode_nmt(canopen::NmtCommand::start, node_));
   }

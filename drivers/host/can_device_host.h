@@ -2,7 +2,7 @@
 // shares (drivers/README.md §2, §8); HandHost and ArmHost derive from it and add their PDOs.
 //   read:  drain the bus (at most 256 frames), let the device decode its PDOs, handle EMCY and
 //          heartbeats, feed the LinkMonitor, track whether the device is operational.
-//   write: bus-off -> restart every restart_period_cycles and send nothing; otherwise one batch
+//   write: bus-off -> restart at once, then every restart_period_cycles, sending nothing; otherwise one batch
 //          of [NMT start while not operational, every nmt_retry_cycles] + the device's frames +
 //          SYNC (next counter) + [host heartbeat every heartbeat_period_cycles].
 // Every call is RT-safe for a MockCanBus (SocketCanBus::restart uses netlink).
@@ -96,6 +96,7 @@ class CanDeviceHost {
 
   int heartbeat_period_cycles_, nmt_retry_cycles_, restart_period_cycles_;
   std::uint16_t seq_ = 0;
+  std::uint64_t bus_off_cycles_ = 0;  // write cycles in a row that found the bus off
   std::uint8_t sync_ = 0;
   bool operational_ = false;
   std::uint64_t cycle_ = 0, send_failures_ = 0, host_timeout_emcys_ = 0;

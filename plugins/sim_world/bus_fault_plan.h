@@ -18,7 +18,7 @@ struct BusFaultConfig {
   std::uint64_t seed = 1;
   double drop = 0.002;            // per frame, every bus
   double corrupt = 0.002;         // per frame, every bus: one payload bit flipped
-  double delay_burst_s = 0.5;     // the burst's length (world s); 0: none
+  double delay_burst_s = 0.03;    // the burst's length (world s); 0: none
   double delay_ms = 5.0;          // how late every frame of the burst arrives
   bool bus_off = true;            // one bus-off of a hand's driver
   std::uint32_t host_node = 100;  // the drivers' node id on the buses (hand_driver `host_node`)

@@ -146,3 +146,43 @@ TEST_CASE("read and write do not allocate") {
   CHECK(crease::rt::rt_allocation_count() == before);
   CHECK(host.monitor().counters().fresh > 50);
 }
+
+TEST_CASE("a bus-off is restarted by the next write cycle and the link recovers well before a device fault (50 cycles)") {
+  crease::drivers::testing::ScopedFifo fifo;
+  const std::string name = crease::drivers::testing::unique_bus("hand-busoff");
+  MockCanBroker broker({name, 1'000'000, 5'000'000, false});
+  MockCanBus host_bus({name, 100, 1'000'000, 5'000'000});
+  MockCanBus dev_bus({name, 1, 1'000'000, 5'000'000});
+  sim::SimHand hand(dev_bus, {.node = 1});
+  sim::DeviceThread dev(dev_bus.fd(), [&](std::int64_t t) { hand.step(t); });
+  HandHost host(host_bus, {.node = 1});
+  hand::Command cmd;
+  cmd.flags = hand::kCmdEnable;
+  hand::Stiffness stiff;
+  Ticker tick;
+  auto cycle = [&] {
+    const std::int64_t now = tick.wait();
+    host.read_from_rt(now);
+    host.write_from_rt(cmd, stiff, now);
+  };
+  bool up = false;
+  for (int i = 0; i < 1000 && !up; ++i) {
+    cycle();
+    up = host.health() == LinkHealth::ok;
+  }
+  REQUIRE(up);
+  // Bus-off at a cycle count that is no multiple of the restart period (the old rule restarted
+  // only on cycle % 100 == 1: up to 100 cycles off, a device fault at 50).
+  for (int i = 0; i < 37; ++i) cycle();
+  broker.force_bus_off(100);
+  int off_cycles = 0, to_ok = -1;
+  for (int i = 0; i < 60 && to_ok < 0; ++i) {
+    cycle();
+    off_cycles += host_bus.state() == BusState::bus_off ? 1 : 0;
+    if (i > 0 && host.health() == LinkHealth::ok) to_ok = i;
+  }
+  CHECK(host_bus.counters().bus_off_events == 1);
+  CHECK(off_cycles <= 3);
+  CHECK(to_ok > 0);
+  CHECK(to_ok < 25);
+}
