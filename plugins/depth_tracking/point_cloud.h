@@ -4,9 +4,11 @@
 // included, depth = z along the optical axis), then the fused cloud is voxel-downsampled.
 //
 // configure() allocates everything (the per-pixel ray tables of each camera, the point buffer
-// of max_points); clear()/add_view()/voxel_downsample() allocate nothing and throw nothing.
+// of max_points, the mask's lookup tables, the voxel hash table); clear()/add_view()/
+// voxel_downsample() allocate nothing and throw nothing.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -32,6 +34,26 @@ struct HsvRange {
 
 // BGR (8 bit) -> OpenCV 8-bit HSV, as cv::cvtColor(COLOR_BGR2HSV). RT-safe.
 void bgr_to_hsv(std::uint8_t b, std::uint8_t g, std::uint8_t r, int& h, int& s, int& v) noexcept;
+
+// HsvRange::contains(bgr_to_hsv(b, g, r)) by two table look-ups (the same arithmetic, tabulated
+// at configure): v and s depend on (max, max - min) only, h on which channel is the largest,
+// max - min and the difference of the other two. Non-RT to build (~460 kB), RT-safe to use.
+class HsvMask {
+ public:
+  void configure(const HsvRange& range);
+  [[nodiscard]] bool contains(std::uint8_t b, std::uint8_t g, std::uint8_t r) const noexcept {
+    const int mx = std::max(b, std::max(g, r)), mn = std::min(b, std::min(g, r)), d = mx - mn;
+    if (!sv_ok_[static_cast<std::size_t>(mx * 256 + d)]) return false;
+    // The channel bgr_to_hsv takes as the maximum (r first, then g) and its hue numerator.
+    const int sector = mx == r ? 0 : (mx == g ? 1 : 2);
+    const int num = sector == 0 ? g - b : (sector == 1 ? b - r : r - g);
+    return h_ok_[static_cast<std::size_t>((sector * 256 + d) * 512 + num + 255)] != 0;
+  }
+
+ private:
+  std::vector<std::uint8_t> sv_ok_;  // [max][max - min]: v and s in range
+  std::vector<std::uint8_t> h_ok_;   // [sector][max - min][numerator + 255]: h in range
+};
 
 struct CloudParams {
   HsvRange mask;
@@ -62,8 +84,8 @@ class CloudBuilder {
   // CV_8UC3 BGR registered to it, both the camera's size. False (nothing added) on a wrong
   // index, size or type. RT-safe.
   bool add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) noexcept;
-  // Replaces the cloud by one point per occupied voxel (the mean of its points); the order is
-  // that of the voxel keys (deterministic). RT-safe.
+  // Replaces the cloud by one point per occupied voxel (the mean of its points, summed in the
+  // order they were added); the order is that of the voxel keys (deterministic). RT-safe.
   void voxel_downsample() noexcept;
 
   [[nodiscard]] std::span<const Eigen::Vector3d> points() const noexcept {
@@ -76,8 +98,15 @@ class CloudBuilder {
   std::vector<vision::Camera> cameras_;
   std::vector<double> units_;                 // per camera, mm per count
   std::vector<std::vector<cv::Vec2f>> rays_;  // per camera, per pixel: undistorted (x/z, y/z)
+  HsvMask mask_;
   std::vector<Eigen::Vector3d> points_;       // capacity max_points
-  std::vector<std::uint64_t> keys_;           // voxel key << 32 | point index, capacity max_points
+  // Voxel grid: open addressing (linear probing) over the first power of two >= 2 x the points of
+  // this frame (so never full); a slot holds its voxel's key | kUsed and the voxel's number.
+  std::vector<std::uint64_t> slot_key_;       // power of two >= 2 max_points
+  std::vector<std::int32_t> slot_voxel_;
+  std::vector<std::uint64_t> voxel_key_;      // per voxel, capacity max_points
+  std::vector<std::int32_t> voxel_count_;     // per voxel: its points
+  std::vector<std::int32_t> order_;           // the voxels by key
   int count_ = 0;
   CloudCounters counters_;
 };

@@ -57,23 +57,34 @@ void SheetCpd::configure(const CpdParams& p, std::span<const Eigen::Vector2d> uv
     q_.col(j) = es.eigenvectors().col(m - 1 - j);
     lambda_[j] = ev[m - 1 - j];
   }
-  dq_.resize(m, rank_);
+  a_.resize(m, rank_);
   s_.resize(rank_, rank_);
   qb_.resize(rank_, 3);
-  qw_.resize(rank_, 3);
   x_.assign(3 * static_cast<std::size_t>(max_points), 0.0);
-  for (auto* v : {&y0_, &y_, &px_, &w_, &b_}) v->assign(3 * static_cast<std::size_t>(m), 0.0);
+  for (auto* v : {&y0_, &y_, &px_, &b_}) v->assign(3 * static_cast<std::size_t>(m), 0.0);
   p1_.assign(m, 0.0);
   active_.assign(m, 1);
   act_idx_.assign(m, 0);
   bucket_start_.assign(kBuckets + 1, 0);
   bucket_nodes_.assign(m, 0);
   node_cell_.assign(3 * static_cast<std::size_t>(m), 0);
+  point_cell_.assign(3 * static_cast<std::size_t>(max_points), 0);
+  point_start_.assign(kBuckets + 1, 0);
+  point_order_.assign(static_cast<std::size_t>(max_points), 0);
+  cand_.assign(3 * static_cast<std::size_t>(m), 0.0);
+  cand_idx_.assign(m, 0);
+  cand_e_.assign(m, 0.0);
   near_idx_.assign(m, 0);
   near_k_.assign(m, 0.0);
+  // The nodes' mean spacing on the sheet (a grid's pitch).
+  Eigen::Vector2d lo = uv[0], hi = uv[0];
+  for (const auto& q : uv) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  const Eigen::Vector2d ext = hi - lo;
+  min_cell_mm_ = ext.x() > 0.0 && ext.y() > 0.0 ? std::sqrt(ext.x() * ext.y() / m) : ext.maxCoeff() / std::max(1, m - 1);
+  min_cell_mm_ = std::max(min_cell_mm_, 1e-3);
 }
 
-void SheetCpd::build_grid(double cell) noexcept {
+void SheetCpd::build_grid(double cell, int n) noexcept {
   cell_mm_ = cell;
   const double inv = 1.0 / cell;
   std::fill(bucket_start_.begin(), bucket_start_.end(), 0);
@@ -92,6 +103,41 @@ void SheetCpd::build_grid(double cell) noexcept {
   }
   for (int b = kBuckets; b > 0; --b) bucket_start_[b] = bucket_start_[b - 1];
   bucket_start_[0] = 0;
+  // The points by bucket (stable: in their order inside a bucket), the same way.
+  std::fill(point_start_.begin(), point_start_.end(), 0);
+  for (int j = 0; j < n; ++j) {
+    for (int c = 0; c < 3; ++c)
+      point_cell_[3 * j + c] = static_cast<std::int32_t>(std::floor(x_[3 * j + c] * inv));
+    ++point_start_[bucket_of(point_cell_[3 * j], point_cell_[3 * j + 1], point_cell_[3 * j + 2], kBuckets) + 1];
+  }
+  for (int b = 0; b < kBuckets; ++b) point_start_[b + 1] += point_start_[b];
+  for (int j = 0; j < n; ++j) {
+    const auto b = bucket_of(point_cell_[3 * j], point_cell_[3 * j + 1], point_cell_[3 * j + 2], kBuckets);
+    point_order_[point_start_[b]++] = j;
+  }
+}
+
+int SheetCpd::gather(std::int32_t cx, std::int32_t cy, std::int32_t cz) noexcept {
+  double* const px = cand_.data();
+  double* const py = px + m_;
+  double* const pz = py + m_;
+  int count = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const std::int32_t ux = cx + dx, uy = cy + dy, uz = cz + dz;
+        const auto b = bucket_of(ux, uy, uz, kBuckets);
+        for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
+          const int i = bucket_nodes_[q];
+          // Another cell hashed into this bucket: its own visit counts it.
+          if (node_cell_[3 * i] != ux || node_cell_[3 * i + 1] != uy || node_cell_[3 * i + 2] != uz) continue;
+          px[count] = y_[3 * i];
+          py[count] = y_[3 * i + 1];
+          pz[count] = y_[3 * i + 2];
+          cand_idx_[count++] = i;
+        }
+      }
+  return count;
 }
 
 double SheetCpd::e_step(int n, double sigma2) noexcept {
@@ -99,45 +145,49 @@ double SheetCpd::e_step(int n, double sigma2) noexcept {
   const double w = params_.w;
   const double c = std::pow(2.0 * std::numbers::pi * sigma2, 1.5) * w / (1.0 - w) *
                    static_cast<double>(n_active_) / static_cast<double>(n);
-  build_grid(std::sqrt(2.0 * sigma2 * cut_));
-  const double inv_cell = 1.0 / cell_mm_;
+  // Cells of at least the cut-off radius: the 27 around a point's hold every node within it.
+  build_grid(std::max(std::sqrt(2.0 * sigma2 * cut_), min_cell_mm_), n);
   for (int a = 0; a < n_active_; ++a) {
     const int i = act_idx_[a];
     p1_[i] = 0.0;
     px_[3 * i] = px_[3 * i + 1] = px_[3 * i + 2] = 0.0;
   }
+  const double* const cx = cand_.data();
+  const double* const cy = cx + m_;
+  const double* const cz = cy + m_;
+  double* const ce = cand_e_.data();
   double neg_log = 0.0, xpx = 0.0;
-  for (int j = 0; j < n; ++j) {
+  int candidates = 0;
+  bool gathered = false;
+  std::int32_t gx = 0, gy = 0, gz = 0;  // the cell whose candidates are gathered
+  for (int q = 0; q < n; ++q) {
+    const int j = point_order_[q];
+    const std::int32_t* const cell = &point_cell_[3 * j];
+    if (!gathered || cell[0] != gx || cell[1] != gy || cell[2] != gz) {
+      gx = cell[0], gy = cell[1], gz = cell[2];
+      candidates = gather(gx, gy, gz);
+      gathered = true;
+    }
     const double xx = x_[3 * j], xy = x_[3 * j + 1], xz = x_[3 * j + 2];
-    const auto cx = static_cast<std::int32_t>(std::floor(xx * inv_cell));
-    const auto cy = static_cast<std::int32_t>(std::floor(xy * inv_cell));
-    const auto cz = static_cast<std::int32_t>(std::floor(xz * inv_cell));
+    for (int a = 0; a < candidates; ++a) {
+      const double ex = xx - cx[a], ey = xy - cy[a], ez = xz - cz[a];
+      ce[a] = (ex * ex + ey * ey + ez * ez) * inv2s;
+    }
     int near = 0;
     double den = c;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const std::int32_t ux = cx + dx, uy = cy + dy, uz = cz + dz;
-          const auto b = bucket_of(ux, uy, uz, kBuckets);
-          for (int q = bucket_start_[b]; q < bucket_start_[b + 1]; ++q) {
-            const int i = bucket_nodes_[q];
-            // Another cell hashed into this bucket: its own visit counts it.
-            if (node_cell_[3 * i] != ux || node_cell_[3 * i + 1] != uy || node_cell_[3 * i + 2] != uz) continue;
-            const double ex = xx - y_[3 * i], ey = xy - y_[3 * i + 1], ez = xz - y_[3 * i + 2];
-            const double e = (ex * ex + ey * ey + ez * ez) * inv2s;
-            if (e >= cut_) continue;
-            const double k = std::exp(-e);
-            near_idx_[near] = i;
-            near_k_[near++] = k;
-            den += k;
-          }
-        }
+    for (int a = 0; a < candidates; ++a) {
+      if (ce[a] >= cut_) continue;
+      const double k = std::exp(-ce[a]);
+      near_idx_[near] = cand_idx_[a];
+      near_k_[near++] = k;
+      den += k;
+    }
     if (!(den > 0.0)) den = std::numeric_limits<double>::min();
     const double inv = 1.0 / den;
     double col = 0.0;
-    for (int q = 0; q < near; ++q) {
-      const int i = near_idx_[q];
-      const double pij = near_k_[q] * inv;
+    for (int k = 0; k < near; ++k) {
+      const int i = near_idx_[k];
+      const double pij = near_k_[k] * inv;
       col += pij;
       p1_[i] += pij;
       px_[3 * i] += pij * xx;
@@ -175,7 +225,7 @@ CpdResult SheetCpd::register_cloud(std::span<const Eigen::Vector3d> nodes, std::
     p1_[i] = 0.0;
     for (int c = 0; c < 3; ++c) {
       y0_[3 * i + c] = y_[3 * i + c] = nodes[static_cast<std::size_t>(i)][c];
-      px_[3 * i + c] = w_[3 * i + c] = 0.0;
+      px_[3 * i + c] = 0.0;
     }
   }
   if (n_active_ == 0) return r;
@@ -202,13 +252,12 @@ CpdResult SheetCpd::register_cloud(std::span<const Eigen::Vector3d> nodes, std::
   const int k = rank_;
   double objective_old = 0.0;
   bool have_old = false;
+  double reg = 0.0;  // tr(W^T G W) of the last M-step (W = 0 before the first)
   for (int it = 0; it < params_.max_iterations; ++it) {
     const double neg_log = e_step(n, sigma2);
     double np = 0.0;
     for (int a = 0; a < n_active_; ++a) np += p1_[act_idx_[a]];
     if (!(np > 0.0)) np = 1e-12;
-    double reg = 0.0;
-    for (int i = 0; i < 3 * m; ++i) reg += w_[i] * (y_[i] - y0_[i]);
     const double objective = neg_log + 1.5 * np * std::log(sigma2) + 0.5 * lambda_mm * reg;
     r.iterations = it + 1;
     if (have_old && std::abs(objective - objective_old) <= params_.tolerance * std::abs(objective)) {
@@ -218,31 +267,28 @@ CpdResult SheetCpd::register_cloud(std::span<const Eigen::Vector3d> nodes, std::
     objective_old = objective;
     have_old = true;
 
-    // M-step (Woodbury): with d = P1 / (lambda' sigma^2) and B' = (PX - d(P1) Y0) / (lambda' sigma^2),
-    // W = B' - d Q (L^-1 + Q^T d Q)^-1 Q^T B'.
+    // M-step (Woodbury): with d = P1 / (lambda' sigma^2), B' = (PX - d(P1) Y0) / (lambda' sigma^2),
+    // S = L^-1 + Q^T d Q and z = S^-1 Q^T B': Y = Y0 + Q z (header).
     const double inv_ls = 1.0 / (lambda_mm * sigma2);
+    int rows = 0;
     for (int i = 0; i < m; ++i) {
-      const double d = p1_[i] * inv_ls;
       for (int c = 0; c < 3; ++c) b_[3 * i + c] = (px_[3 * i + c] - p1_[i] * y0_[3 * i + c]) * inv_ls;
-      for (int j = 0; j < k; ++j) dq_(i, j) = d * q_(i, j);
+      if (p1_[i] > 0.0) a_.row(rows++) = std::sqrt(p1_[i] * inv_ls) * q_.row(i);
     }
-    s_.noalias() = q_.transpose() * dq_;
+    s_.setZero();
+    s_.selfadjointView<Eigen::Lower>().rankUpdate(a_.topRows(rows).transpose());
     for (int j = 0; j < k; ++j) s_(j, j) += 1.0 / lambda_[j];
     Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> bm(b_.data(), m, 3);
     qb_.noalias() = q_.transpose() * bm;
-    Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(s_);
+    Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(s_);
     if (llt.info() != Eigen::Success) return r;
     llt.solveInPlace(qb_);
-    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> wm(w_.data(), m, 3);
-    wm = bm;
-    wm.noalias() -= dq_ * qb_;
-    // Y = Y0 + Q L Q^T W.
-    qw_.noalias() = q_.transpose() * wm;
-    for (int j = 0; j < k; ++j) qw_.row(j) *= lambda_[j];
     Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> ym(y_.data(), m, 3);
     Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> y0m(y0_.data(), m, 3);
     ym = y0m;
-    ym.noalias() += q_ * qw_;
+    ym.noalias() += q_ * qb_;
+    reg = 0.0;
+    for (int j = 0; j < k; ++j) reg += qb_.row(j).squaredNorm() / lambda_[j];
     // sigma^2 over the active nodes.
     double pxy = 0.0, ypy = 0.0;
     for (int a = 0; a < n_active_; ++a) {

@@ -7,11 +7,16 @@
 //    variant) is computed once at configure; and two layers lying on each other (a fold) are
 //    not coupled by it;
 //  - the M-step by the Woodbury identity, (G + lambda' sigma^2 d(P1)^-1)^-1 in O(M K^2 + K^3)
-//    instead of an M x M Cholesky; a node with P1 = 0 needs no special case;
+//    instead of an M x M Cholesky; a node with P1 = 0 needs no special case. With
+//    S = L^-1 + Q^T d Q (d = P1 / (lambda' sigma^2)) and z = S^-1 Q^T B', Q^T W = L^-1 z, so
+//    Y = Y0 + Q z and tr(W^T G W) = tr(z^T L^-1 z): W itself is never formed, and Q^T d Q is a
+//    symmetric rank update over the nodes with P1 > 0;
 //  - the E-step over the ACTIVE nodes only (those some camera sees: visibility.h; the others
 //    get P1 = 0, move only with their neighbours through G and get no target), each point
-//    visiting the active nodes of the 27 grid cells around it (cells of the kernel's cut-off
-//    radius, rebuilt every iteration): kernel values below exp(-cut) are zero (cpd.h: exp(-40)).
+//    visiting the active nodes of the 27 grid cells around it (cells at least the kernel's
+//    cut-off radius, rebuilt every iteration): kernel values below exp(-cut) are zero (cpd.h:
+//    exp(-40)). The points are taken cell by cell (a counting sort per iteration), so the nodes
+//    around a cell are gathered once for all its points.
 // configure() allocates everything; register_cloud() allocates nothing, takes no lock, throws
 // nothing.
 #pragma once
@@ -48,16 +53,17 @@ class SheetCpd {
 
  private:
   double e_step(int n, double sigma2) noexcept;  // returns -sum log(denominator); fills p1, px, xpx_
-  void build_grid(double cell_mm) noexcept;
+  void build_grid(double cell_mm, int n) noexcept;  // the active nodes' and the n points' cells
+  int gather(std::int32_t cx, std::int32_t cy, std::int32_t cz) noexcept;  // candidates around a cell
 
   CpdParams params_;
   int m_ = 0, max_points_ = 0, rank_ = 0;
   Eigen::MatrixXd q_;       // M x K eigenvectors of G
   Eigen::VectorXd lambda_;  // K eigenvalues
-  Eigen::MatrixXd dq_, s_;  // d(P1)/(lambda' sigma^2) Q (M x K); the K x K Woodbury system
-  Eigen::MatrixXd qb_, qw_;  // K x 3
+  Eigen::MatrixXd a_, s_;   // rows sqrt(d_i) Q_i of the nodes with P1 > 0 (M x K); S (K x K, lower)
+  Eigen::MatrixXd qb_;      // K x 3: Q^T B', then z
   std::vector<double> x_;   // 3 N
-  std::vector<double> y0_, y_, px_, w_, b_;  // 3 M
+  std::vector<double> y0_, y_, px_, b_;  // 3 M
   std::vector<double> p1_;  // M
   std::vector<std::uint8_t> active_;
   std::vector<std::int32_t> act_idx_;  // the active nodes
@@ -68,9 +74,16 @@ class SheetCpd {
   std::vector<std::int32_t> bucket_start_;  // kBuckets + 1
   std::vector<std::int32_t> bucket_nodes_;  // active nodes by bucket
   std::vector<std::int32_t> node_cell_;     // 3 per node: its cell
+  std::vector<std::int32_t> point_cell_;    // 3 per point: its cell
+  std::vector<std::int32_t> point_start_;   // kBuckets + 1
+  std::vector<std::int32_t> point_order_;   // the points by bucket of their cell
+  std::vector<double> cand_;                // 3 per candidate node: its position ...
+  std::vector<std::int32_t> cand_idx_;      // ... and its number (the nodes around a cell)
+  std::vector<double> cand_e_;              // per candidate: the kernel's exponent for a point
   std::vector<std::int32_t> near_idx_;      // per point: the nodes within the cut-off ...
   std::vector<double> near_k_;              // ... and their kernel values
   double cell_mm_ = 1.0;
+  double min_cell_mm_ = 1.0;  // the nodes' mean spacing: smaller cells cost more look-ups than they save
   double cut_ = 20.0;
 };
 

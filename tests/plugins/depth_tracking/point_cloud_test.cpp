@@ -4,8 +4,11 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
 #include <random>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -14,6 +17,8 @@
 
 using crease::depth::CloudBuilder;
 using crease::depth::CloudParams;
+using crease::depth::HsvMask;
+using crease::depth::HsvRange;
 
 namespace {
 
@@ -79,6 +84,28 @@ TEST_CASE("bgr_to_hsv agrees with OpenCV's COLOR_BGR2HSV") {
     CHECK(std::abs(h - o[0]) % 179 <= 1);  // rounding; 0 and 179 are neighbours
     CHECK(std::abs(s - o[1]) <= 1);
     CHECK(v == o[2]);
+  }
+}
+
+TEST_CASE("the mask's tables decide as bgr_to_hsv and HsvRange::contains, for every colour") {
+  // The cloud's range, one whose hue wraps through 0 (reds) with tight s and v, a grey band.
+  const HsvRange ranges[] = {{90, 115, 100, 255, 80, 255}, {170, 8, 60, 200, 30, 220}, {0, 179, 0, 12, 100, 140}};
+  for (const HsvRange& range : ranges) {
+    HsvMask mask;
+    mask.configure(range);
+    long long mismatches = 0, inside = 0;
+    for (int b = 0; b < 256; ++b)
+      for (int g = 0; g < 256; ++g)
+        for (int r = 0; r < 256; ++r) {
+          int h, s, v;
+          crease::depth::bgr_to_hsv(std::uint8_t(b), std::uint8_t(g), std::uint8_t(r), h, s, v);
+          const bool want = range.contains(h, s, v);
+          inside += want;
+          mismatches += want != mask.contains(std::uint8_t(b), std::uint8_t(g), std::uint8_t(r));
+        }
+    MESSAGE("h " << range.h_lo << ".." << range.h_hi << ": " << inside << " colours inside");
+    CHECK(inside > 0);
+    CHECK(mismatches == 0);
   }
 }
 
@@ -166,6 +193,36 @@ TEST_CASE("invalid depth is dropped and counted; voxel downsampling keeps the pl
   REQUIRE(small.add_view(0, v.depth, v.bgr));
   CHECK(small.points().size() == 100);
   CHECK(small.counters().overflow > 0);
+}
+
+TEST_CASE("voxel downsampling: one mean per occupied voxel, in the order of the voxels' cells") {
+  const View v = render(4);
+  for (const double voxel : {3.0, 10.0, 40.0}) {
+    CloudParams p = sheet_mask();
+    p.voxel_mm = voxel;
+    CloudBuilder b;
+    b.configure(p, {v.cam}, 200000);
+    REQUIRE(b.add_view(0, v.depth, v.bgr));
+    REQUIRE(b.add_view(0, v.depth, v.bgr));  // every voxel's points twice, and not side by side
+    // The reference: the raw points grouped by cell (x, then y, then z: the key's order).
+    const double inv = 1.0 / voxel;  // as the builder computes the cells
+    std::map<std::array<long long, 3>, std::pair<Eigen::Vector3d, int>> cells;
+    for (const auto& q : b.points()) {
+      const std::array<long long, 3> cell = {static_cast<long long>(std::floor(q.x() * inv)),
+                                             static_cast<long long>(std::floor(q.y() * inv)),
+                                             static_cast<long long>(std::floor(q.z() * inv))};
+      auto& c = cells.try_emplace(cell, Eigen::Vector3d::Zero(), 0).first->second;
+      c.first += q;
+      ++c.second;
+    }
+    b.voxel_downsample();
+    REQUIRE(b.points().size() == cells.size());
+    double worst = 0.0;
+    std::size_t i = 0;
+    for (const auto& [cell, sum] : cells) worst = std::max(worst, (b.points()[i++] - sum.first / sum.second).norm());
+    MESSAGE(voxel << " mm: " << cells.size() << " voxels, largest difference to the reference " << worst << " mm");
+    CHECK(worst < 1e-9);  // the same means, summed in another order
+  }
 }
 
 TEST_CASE("bad cloud parameters are ConfigErrors naming the key; wrong images are refused") {
