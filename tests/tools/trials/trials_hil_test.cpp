@@ -6,6 +6,7 @@
 // so from the world's truth (a scorer that cannot fail is worthless), the retreat must leave
 // the hands clear of the sheet (the world's fingertips), and every row, the JSON summary, each
 // trial's report, the summary line and the HTML report with a plot per trial must be there.
+// With --faults the trial runs with the world's bus faults and the cameras' dropouts and says so.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -104,5 +105,36 @@ TEST_CASE("crease-trials: two short trials run, are scored from the world's trut
   for (std::size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) ++plots;
   CHECK(plots == 2);
   for (int k = 0; k < 2; ++k) CHECK(j["trials"][k]["series"]["t_s"].size() > 100);  // 6 s at 50 Hz
+  fs::remove_all(dir);
+}
+
+TEST_CASE("crease-trials --faults: the trial runs with the world's bus faults and the cameras' dropouts, drawn from its seed, and says so") {
+  char tmpl[] = "/tmp/crease-trials-XXXXXX";
+  const fs::path dir = mkdtemp(tmpl);
+  const std::string cmd = std::string(CREASE_BIN_DIR) + "/crease-trials --trials 1 --seed 5 --faults --max-fold-s 4 --retain-s 0" +
+                          " --config " CREASE_SOURCE_DIR "/config/sim.yaml --plugin-dir " CREASE_PLUGIN_DIR +
+                          " --out " + dir.string() + " 2>&1";
+  FILE* f = popen(cmd.c_str(), "r");
+  REQUIRE(f != nullptr);
+  std::string out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof(buf), f) != nullptr) out += buf;
+  const int rc = pclose(f);
+  INFO(out);
+  REQUIRE(WIFEXITED(rc));
+  CHECK(WEXITSTATUS(rc) == 0);
+  CHECK(out.find("trials: fold=half n=1 success=0 faults=1 ") != std::string::npos);
+  std::ifstream js(dir / "trials.json");
+  const auto j = nlohmann::json::parse(js);
+  CHECK(j["faults"] == true);
+  REQUIRE(j["trials"].size() == 1);
+  const auto& t = j["trials"][0];
+  CHECK(t["error"] == "");
+  CHECK(t["draws"].get<std::string>().find("; bus faults (seed 5): drop 0.002, corrupt 0.002") != std::string::npos);
+  CHECK(t["hands_clear"] == true);
+  // The world logged the plan it injects (the same as the trial's draws).
+  std::ifstream log_in(dir / "trial_0" / "creased.log");
+  const std::string log((std::istreambuf_iterator<char>(log_in)), std::istreambuf_iterator<char>());
+  CHECK(log.find("world: bus faults (seed 5)") != std::string::npos);
   fs::remove_all(dir);
 }
