@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -33,6 +34,7 @@
 #include "bench_util.h"
 #include "plugins/arm_motion/arm_motion.h"
 #include "plugins/robot_model/arm_ik.h"
+#include "plugins/sim_world/world_config.h"
 
 namespace {
 
@@ -151,9 +153,19 @@ IkFigures bench_ik(RobotModel& m, int poses) {
   return f;
 }
 
+// Where the controller stage's arms work: creased's parked posture (sim_world's, each index pad
+// 300 mm over the table), inside arm_motion's workspace box. (From the rest posture above, the
+// arms hanging 1 m over the table, every goal lay outside it and was refused: the stage then
+// timed no arm motion at all.)
+Joints parked_of(Side s) {
+  Joints q{};
+  for (int j = 0; j < kArmJoints; ++j) q[j] = crease::world::kParkedArmDeg[s == Side::right ? 0 : 1][j] * std::numbers::pi / 180.0;
+  return q;
+}
+
 // One arm with an arm that follows its command (a perfect drive).
 struct Arm {
-  Arm(RobotModel& m, Side s) : side(s), q(rest_of(s)) {
+  Arm(RobotModel& m, Side s) : side(s), q(parked_of(s)) {
     arm_motion::MotionParams p;
     p.ik.rest_rad = rest_of(s);
     motion = std::make_unique<arm_motion::ArmMotion>(m, s, p);
@@ -267,7 +279,7 @@ StageTimes bench_stage(RobotModel& m, double seconds, bool paced) {
         const ToolFrame tool = (id % 2 == 0) ? ToolFrame::ff_pad : ToolFrame::palm_front;
         Hand h{};
         KDL::Frame rest;
-        (void)m.tool_pose_m(arm.side, tool, rest_of(arm.side), h, rest);
+        (void)m.tool_pose_m(arm.side, tool, parked_of(arm.side), h, rest);
         pending[a] = goal(KDL::Frame(KDL::Rotation::RotZ(off(rng)) * rest.M,
                                      rest.p + KDL::Vector(off(rng), off(rng), off(rng))),
                           ++id, tool);
@@ -295,6 +307,13 @@ StageTimes bench_stage(RobotModel& m, double seconds, bool paced) {
   for (const Arm& a : arms) {
     accepted += a.motion->status().goals_accepted;
     refused += a.motion->status().goals_refused;
+  }
+  if (accepted == 0) {  // the stage would time refusals, not motion: say so, with why
+    std::printf("WARNING: no arm goal was accepted; refusals by ArmMotionReason:");
+    for (const Arm& a : arms)
+      for (int r = 0; r < kArmMotionReasons; ++r)
+        if (a.motion->status().reasons[r] != 0) std::printf(" %d:%u", r, a.motion->status().reasons[r]);
+    std::printf("\n");
   }
   sp.sched_priority = 0;
   (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &sp);
