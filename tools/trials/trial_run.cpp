@@ -11,8 +11,6 @@
 #include <stdexcept>
 #include <thread>
 
-#include <yaml-cpp/yaml.h>
-
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
 #include "core/port_types/hand_control.h"
@@ -24,6 +22,7 @@
 #include "plugins/robot_model/robot_params.h"
 #include "plugins/sim_world/bus_fault_plan.h"
 #include "plugins/sim_world/randomise.h"
+#include "plugins/sim_world/world_config.h"
 #include "rt/clock.h"
 #include "rt/latest.h"
 
@@ -43,36 +42,14 @@ std::unique_ptr<rt::LatestReader<T>> reader(PluginHost& host, const std::string&
   return std::make_unique<rt::LatestReader<T>>(ch);
 }
 
-// The world's draws for SEED from the world instance's parameters (as sim_world makes them).
-std::string describe_draws(const config::DaemonConfig& cfg, std::uint64_t seed) {
+// The world's draws and its bus faults' plan as the sim_world instance makes them (its
+// parameters read by the plugin's own reader, the trial's seed already in them).
+std::string describe_draws(const config::DaemonConfig& cfg) {
   for (const auto& p : cfg.plugins) {
     if (p.library != "sim_world") continue;
-    world::WorldParams w;
-    w.seed = seed;
-    const YAML::Node& n = p.params;
-    auto num = [&](const char* key, double& v) {
-      if (n[key]) v = n[key].as<double>();
-    };
-    if (n["randomise"]) w.randomise = n["randomise"].as<bool>();
-    num("sheet_offset_mm", w.sheet_offset_mm);
-    num("sheet_yaw_deg", w.sheet_yaw_deg);
-    num("stiffness_fraction", w.stiffness_fraction);
-    num("yield_fraction", w.yield_fraction);
-    num("friction_fraction", w.friction_fraction);
-    const fs::path robot = fs::path(cfg.file).parent_path() / n["robot"].as<std::string>();
-    std::string out = world::describe(seed, world::draw_world(w, robot::load_robot_params(robot.string())));
-    if (n["faults"] && n["faults"].as<bool>()) {  // as world_config.cpp reads them
-      world::BusFaultConfig f;
-      f.seed = n["fault_seed"] ? n["fault_seed"].as<std::uint64_t>() : seed;
-      num("fault_drop", f.drop);
-      num("fault_corrupt", f.corrupt);
-      num("fault_delay_ms", f.delay_ms);
-      num("fault_delay_burst_s", f.delay_burst_s);
-      num("fault_from_s", f.from_s);
-      num("fault_to_s", f.to_s);
-      if (n["fault_bus_off"]) f.bus_off = n["fault_bus_off"].as<bool>();
-      out += "; " + world::describe(world::draw_bus_faults(f));
-    }
+    const world::WorldPluginConfig w = world::read_world_config(Params(p.params, cfg.file, p.name + ".params"));
+    std::string out = world::describe(w.world.seed, world::draw_world(w.world, robot::load_robot_params(w.robot_yaml)));
+    if (w.faults) out += "; " + world::describe(world::draw_bus_faults(w.bus_faults));
     return out;
   }
   return "no sim_world instance";
@@ -170,7 +147,7 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
       for (int c = 0; c < 2; ++c) target.line_mm[k][c] = spec.fold_line_mm[k][c];
     target.flap_corner_mm[0] = spec.corner_mm[0];
     target.flap_corner_mm[1] = spec.corner_mm[1];
-    r.draws = describe_draws(cfg, seed);
+    r.draws = describe_draws(cfg);
     const std::string status_name = port_of(cfg, fold, "sequence_status");
     // The hands' force controllers' status, as the sequence reads it.
     const std::string hand_status_name[2] = {port_of(cfg, fold, "hand_r_status"), port_of(cfg, fold, "hand_l_status")};

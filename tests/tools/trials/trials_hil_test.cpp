@@ -23,18 +23,36 @@
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// crease-trials ARGS (with sim.yaml, the built plugins and --out DIR): its output and exit status.
+struct Run {
+  std::string out;
+  int rc = 0;
+};
+Run crease_trials(const std::string& args, const fs::path& dir) {
+  const std::string cmd = std::string(CREASE_BIN_DIR) + "/crease-trials " + args + " --config " CREASE_SOURCE_DIR
+                          "/config/sim.yaml --plugin-dir " CREASE_PLUGIN_DIR " --out " + dir.string() + " 2>&1";
+  Run r;
+  FILE* f = popen(cmd.c_str(), "r");
+  REQUIRE(f != nullptr);
+  char buf[4096];
+  while (std::fgets(buf, sizeof(buf), f) != nullptr) r.out += buf;
+  r.rc = pclose(f);
+  return r;
+}
+
+std::string read_all(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
 TEST_CASE("crease-trials: two short trials run, are scored from the world's truth as unfolded, and the hands end clear") {
   char tmpl[] = "/tmp/crease-trials-XXXXXX";
   const fs::path dir = mkdtemp(tmpl);
-  const std::string cmd = std::string(CREASE_BIN_DIR) + "/crease-trials --trials 2 --seed 3 --max-fold-s 6 --retain-s 0" +
-                          " --config " CREASE_SOURCE_DIR "/config/sim.yaml --plugin-dir " CREASE_PLUGIN_DIR +
-                          " --out " + dir.string() + " 2>&1";
-  FILE* f = popen(cmd.c_str(), "r");
-  REQUIRE(f != nullptr);
-  std::string out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof(buf), f) != nullptr) out += buf;
-  const int rc = pclose(f);
+  const auto [out, rc] = crease_trials("--trials 2 --seed 3 --max-fold-s 6 --retain-s 0", dir);
   INFO(out);
   REQUIRE(WIFEXITED(rc));
   CHECK(WEXITSTATUS(rc) == 0);
@@ -98,8 +116,7 @@ TEST_CASE("crease-trials: two short trials run, are scored from the world's trut
   }
   CHECK(draws[0] != draws[1]);  // each trial its own world
   // The one report of every trial: a plot of each (the trials' series, from the world's truth).
-  std::ifstream html_in(dir / "trials.html");
-  const std::string html((std::istreambuf_iterator<char>(html_in)), std::istreambuf_iterator<char>());
+  const std::string html = read_all(dir / "trials.html");
   CHECK(html.rfind("<!DOCTYPE html>", 0) == 0);
   std::size_t plots = 0;
   for (std::size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) ++plots;
@@ -111,15 +128,7 @@ TEST_CASE("crease-trials: two short trials run, are scored from the world's trut
 TEST_CASE("crease-trials --faults: the trial runs with the world's bus faults and the cameras' dropouts, drawn from its seed, and says so") {
   char tmpl[] = "/tmp/crease-trials-XXXXXX";
   const fs::path dir = mkdtemp(tmpl);
-  const std::string cmd = std::string(CREASE_BIN_DIR) + "/crease-trials --trials 1 --seed 5 --faults --max-fold-s 4 --retain-s 0" +
-                          " --config " CREASE_SOURCE_DIR "/config/sim.yaml --plugin-dir " CREASE_PLUGIN_DIR +
-                          " --out " + dir.string() + " 2>&1";
-  FILE* f = popen(cmd.c_str(), "r");
-  REQUIRE(f != nullptr);
-  std::string out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof(buf), f) != nullptr) out += buf;
-  const int rc = pclose(f);
+  const auto [out, rc] = crease_trials("--trials 1 --seed 5 --faults --max-fold-s 4 --retain-s 0", dir);
   INFO(out);
   REQUIRE(WIFEXITED(rc));
   CHECK(WEXITSTATUS(rc) == 0);
@@ -133,8 +142,7 @@ TEST_CASE("crease-trials --faults: the trial runs with the world's bus faults an
   CHECK(t["draws"].get<std::string>().find("; bus faults (seed 5): drop 0.002, corrupt 0.002") != std::string::npos);
   CHECK(t["hands_clear"] == true);
   // The world logged the plan it injects (the same as the trial's draws).
-  std::ifstream log_in(dir / "trial_0" / "creased.log");
-  const std::string log((std::istreambuf_iterator<char>(log_in)), std::istreambuf_iterator<char>());
+  const std::string log = read_all(dir / "trial_0" / "creased.log");
   CHECK(log.find("world: bus faults (seed 5)") != std::string::npos);
   fs::remove_all(dir);
 }
