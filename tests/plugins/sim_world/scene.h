@@ -229,6 +229,21 @@ inline Vec3 sheet_centroid(const World& w) {
   return (1.0 / static_cast<double>(x.size())) * c;
 }
 
+// The largest stretch of the sheet's grid edges (along u and v) against the flat sheet's
+// spacing: 0.1 is 10 %.
+inline double max_edge_stretch(const World& w) {
+  const auto x = w.sheet().positions();
+  const auto& g = w.sheet().grid();
+  double worst = 0;
+  for (int j = 0; j < g.h; ++j)
+    for (int i = 0; i < g.w; ++i) {
+      const Vec3 p = x[g.index(i, j)];
+      if (i + 1 < g.w) worst = std::max(worst, sheet::norm(x[g.index(i + 1, j)] - p) / g.du - 1.0);
+      if (j + 1 < g.h) worst = std::max(worst, sheet::norm(x[g.index(i, j + 1)] - p) / g.dv - 1.0);
+    }
+  return worst;
+}
+
 inline WorldParams nominal() {
   WorldParams p;
   p.randomise = false;

@@ -114,6 +114,7 @@ struct Fold {
   double edges_apart_mm = 0;  // mean over the columns: far-edge node to near-edge node, in x, y
   double peak_n = 0;          // the highest normal force on a pinching fingertip over the fold (what its taxels read)
   double on_top = 0;          // fraction of the far half's nodes (rows 0-15) above their mirror node (40 - row) by > 0.5 mm
+  double worst_stretch = 0;   // the grid's largest edge stretch over the fold (every 50 ms; 0.1: 10 %)
 };
 
 double edges_apart(const World& w) {
@@ -230,6 +231,7 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {
     const Vec3 rel = b.world->sheet().positions()[node] - pad(b.hand(Side::right), 0);
     out.worst_slip_mm = std::max(out.worst_slip_mm, sheet::norm(rel - rel0));
     for (const auto& t : b.hand(Side::right).tip) out.peak_n = std::max(out.peak_n, double(t.normal_force_n));
+    if (i % 50 == 0) out.worst_stretch = std::max(out.worst_stretch, max_edge_stretch(*b.world));
   }
   b.hold(0.5);
   out.near_drag_mm = std::fabs(near_edge_y(*b.world) - near0);
@@ -248,7 +250,9 @@ Fold fold(WorldParams p, Bimanual& b, bool fixate = true, const Grasp& grasp = {
 void print(const std::string& tag, const Fold& f) {
   MESSAGE(tag << ": pinch " << f.pinch_n << " N (peak " << f.peak_n << " N), worst slip " << f.worst_slip_mm
               << " mm, near edge dragged " << f.near_drag_mm << " mm; far edge " << f.edges_apart_mm << " mm from the near edge, "
-              << 100.0 * f.on_top << " % of the far half on top of the near half");
+              << 100.0 * f.on_top << " % of the far half on top of the near half"
+              << (f.worst_stretch > 0 ? "; largest edge stretch over the fold " + std::to_string(100.0 * f.worst_stretch) + " %"
+                                      : std::string()));
 }
 
 // After the fold (the left index out from under the layer): config/folds/half.yaml's (e) and (f).

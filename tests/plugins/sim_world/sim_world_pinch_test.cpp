@@ -23,6 +23,7 @@ struct Pinch {
   double force_n = 0;  // squeeze between the pads once closed
   double rise_mm = 0;  // of the pinched sheet point over the 50 mm lift
   double slip_mm = 0;  // of that point relative to the index pad, over the lift and the pull
+  double stretch[3] = {};  // the grid's largest edge stretch: closed, lifted, pulled
 };
 
 Pinch pinch(WorldParams p) {
@@ -38,6 +39,7 @@ Pinch pinch(WorldParams p) {
   }
   Pinch out;
   out.force_n = rig.hand().tip[0].normal_force_n;
+  out.stretch[0] = max_edge_stretch(*rig.world);
   const auto x = rig.world->sheet().positions();
   int node = 0;
   for (int i = 1; i < rig.world->sheet().node_count(); ++i)
@@ -50,14 +52,18 @@ Pinch pinch(WorldParams p) {
   const Vec3 rel0 = z0 - pad();
   rig.move({at.x, at.y, 48.8}, 5.0, 0.2);
   out.rise_mm = rig.world->sheet().positions()[node].z - z0.z;
+  out.stretch[1] = max_edge_stretch(*rig.world);
   rig.move({at.x, at.y - 60, 48.8}, 20.0, 0.3);
+  out.stretch[2] = max_edge_stretch(*rig.world);
   out.slip_mm = sheet::norm((rig.world->sheet().positions()[node] - pad()) - rel0);
   return out;
 }
 
 void print(const std::string& tag, const Pinch& p) {
   MESSAGE(tag << ": pinch " << p.force_n << " N; the pinched point rose " << p.rise_mm
-              << " mm of 50, slipped " << p.slip_mm << " mm over the lift and a 60 mm pull");
+              << " mm of 50, slipped " << p.slip_mm << " mm over the lift and a 60 mm pull; largest edge stretch "
+              << 100 * p.stretch[0] << " / " << 100 * p.stretch[1] << " / " << 100 * p.stretch[2]
+              << " % (closed / lifted / pulled)");
 }
 
 // Held: the point rose with the hand and did not slip by the pads' length (18 mm; a lost sheet
