@@ -69,9 +69,28 @@ void LinkMonitor::end_read(bool bus_off) noexcept {
       ++i;
     }
   }
+  // A bus-off episode: from the cycle the bus is found off until the device's next fresh status.
+  if (bus_off) {
+    if (bus_off_age_ < 0) {
+      bus_off_age_ = 0;
+      bus_off_faulted_ = false;
+      ++counters_.bus_offs;
+    } else {
+      ++bus_off_age_;
+    }
+  } else if (bus_off_age_ >= 0) {
+    if (fresh_this_cycle_) {
+      if (!bus_off_faulted_) ++counters_.bus_offs_ridden;
+      bus_off_age_ = -1;
+    } else {
+      ++bus_off_age_;
+    }
+  }
+  const bool grace = bus_off_age_ >= 0 && bus_off_age_ < cfg_.bus_off_grace_cycles && ever_fresh_;
+  if (bus_off_age_ >= 0 && !grace) bus_off_faulted_ = true;
   const LinkHealth before = health_;
-  if (bus_off || emergency_ || crc_in_window_ > cfg_.crc_threshold || silent_cycles_ >= cfg_.timeout_cycles ||
-      !ever_fresh_) {
+  if ((bus_off && !grace) || emergency_ || crc_in_window_ > cfg_.crc_threshold ||
+      (silent_cycles_ >= cfg_.timeout_cycles && !grace) || !ever_fresh_) {
     health_ = LinkHealth::fault;
     if (before != LinkHealth::fault && silent_cycles_ >= cfg_.timeout_cycles) ++counters_.timeouts;
   } else if (!fresh_this_cycle_ || crc_this_cycle_ > 0) {

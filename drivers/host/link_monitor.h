@@ -27,11 +27,17 @@ struct LinkMonitorConfig {
   // (Status::device_fault, device_port_glue.h): shorter gaps command the safe state all the
   // same but are no device fault (a loaded machine's late answers are not a lost device).
   int device_fault_cycles = 50;
+  // A bus-off the host restarts at once (can_device_host.h) is `degraded`, not `fault`, for its
+  // first bus_off_grace_cycles cycles, the device's silence then included: the data is a few
+  // cycles old, as after lost frames, and a consumer's own staleness bound decides. A bus-off
+  // still off, or a device still silent, after that is a fault as before. 0: a fault at once.
+  int bus_off_grace_cycles = 3;
 };
 
 struct LinkCounters {
   std::uint64_t commands_sent = 0, commands_acked = 0, commands_failed = 0;
   std::uint64_t fresh = 0, stale = 0, bad_crc = 0, timeouts = 0, emergencies = 0, recoveries = 0;
+  std::uint64_t bus_offs = 0, bus_offs_ridden = 0;  // bus-offs seen; of them, over within the grace
 };
 
 class LinkMonitor {
@@ -72,6 +78,8 @@ class LinkMonitor {
   bool emergency_ = false;
   bool ever_fresh_ = false;
   int silent_cycles_ = 0;
+  int bus_off_age_ = -1;  // cycles since the current bus-off began, until a fresh status; -1: none
+  bool bus_off_faulted_ = false;  // the current bus-off outlived its grace
   std::uint16_t last_acked_ = 0;
   std::uint8_t last_sync_sent_ = 0;
   std::uint32_t last_device_time_ = 0;

@@ -38,6 +38,7 @@ LinkMonitorConfig monitor_from_params(const Params& p) {
   m.timeout_cycles = p.get_in_range<int>("timeout_cycles", 2, 1, 100);
   m.crc_threshold = p.get_in_range<int>("crc_threshold", 10, 0, 1000);
   m.device_fault_cycles = p.get_in_range<int>("device_fault_cycles", 50, 1, 1'000'000);
+  m.bus_off_grace_cycles = p.get_in_range<int>("bus_off_grace_cycles", 3, 0, 100);
   return m;
 }
 

@@ -4,7 +4,8 @@
 //   bus_prefix mock only: the bus is `<bus_prefix>-<bus>`, "auto" the daemon's own prefix
 //              (bus_prefix.h); absent: `bus` is the whole name
 //   host_node  this controller's node id on a mocked bus (default 100)
-//   timeout_cycles, crc_threshold, device_fault_cycles   the link monitor (LinkMonitorConfig)
+//   timeout_cycles, crc_threshold, device_fault_cycles, bus_off_grace_cycles   the link monitor
+//              (LinkMonitorConfig)
 // Errors throw ConfigError naming the file, line and key (crease::Params).
 #pragma once
 

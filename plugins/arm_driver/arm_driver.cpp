@@ -2,7 +2,8 @@
 //   input  arm_command (latest ArmCommand)
 //   output arm_state   (latest ArmState: positions, velocities, drive state, health, acks)
 // Parameters: bus_kind ("mock" | "socketcan"), bus (required), node (required, 1..126),
-//   host_node (mock, default 100), timeout_cycles (2), crc_threshold (10), device_fault_cycles (50).
+//   host_node (mock, default 100), timeout_cycles (2), crc_threshold (10),
+//   device_fault_cycles (50), bus_off_grace_cycles (3).
 // Cycle phases: update reads the bus and publishes arm_state; write sends the newest arm_command
 // (a controller after the driver in the loop is answered in the same cycle).
 // The drive is brought to operation enabled by the driver itself (and fault-reset when it

@@ -22,6 +22,7 @@
 //   timeout_cycles  cycles without a fresh status before fault (default 2)
 //   crc_threshold   bad-CRC frames per 100 cycles before fault (default 10)
 //   device_fault_cycles cycles in fault before it is reported as a device fault (default 50)
+//   bus_off_grace_cycles a bus-off's cycles reported degraded, not fault (default 3)
 // Threads: the tactile link's reader thread ("crease-tactile", on the non-RT CPUs, SCHED_FIFO
 // tactile_priority where permitted) runs from
 // activate to deactivate: it sends Start, deframes and decodes, and queues every sample.

@@ -2,14 +2,17 @@
 
 #include <doctest/doctest.h>
 
+#include <initializer_list>
+
 using namespace crease::drivers;
 
 namespace {
 // One cycle: optionally a status answering the previous SYNC and acking the previous seq.
-void cycle(LinkMonitor& m, std::uint16_t& seq, std::uint8_t& sync, std::uint32_t& t, bool answer) {
+void cycle(LinkMonitor& m, std::uint16_t& seq, std::uint8_t& sync, std::uint32_t& t, bool answer,
+           bool bus_off = false) {
   m.begin_read();
   if (answer) m.on_status(seq, sync, t += 1000);
-  m.end_read(false);
+  m.end_read(bus_off);
   m.on_sent(++seq, ++sync);
 }
 }  // namespace
@@ -79,4 +82,37 @@ TEST_CASE("bad CRCs above the threshold, bus-off and emergencies give fault") {
   CHECK(m.health() == LinkHealth::fault);
   m.on_emergency(true);
   CHECK(m.emergency_active());
+}
+
+// A bus-off the host restarts at once: degraded while it lasts up to bus_off_grace_cycles (the
+// device's silence until its next answer included), a fault past that, and at once with no grace.
+TEST_CASE("a bus-off over within its grace is degraded; a longer one, or with no grace, a fault") {
+  for (const int off : {1, 2, 3, 4, 10}) {
+    for (const int grace : {3, 0}) {
+      CAPTURE(off);
+      CAPTURE(grace);
+      LinkMonitorConfig cfg;
+      cfg.bus_off_grace_cycles = grace;
+      LinkMonitor m(cfg);
+      std::uint16_t seq = 0;
+      std::uint8_t sync = 0;
+      std::uint32_t t = 0;
+      for (int i = 0; i < 5; ++i) cycle(m, seq, sync, t, true);
+      REQUIRE(m.health() == LinkHealth::ok);
+      bool faulted = false;
+      // OFF cycles with the bus off (no answer), then one restarted cycle the device is silent in.
+      for (int i = 0; i < off; ++i) {
+        cycle(m, seq, sync, t, false, true);
+        faulted |= m.health() == LinkHealth::fault;
+      }
+      cycle(m, seq, sync, t, false);
+      faulted |= m.health() == LinkHealth::fault;
+      cycle(m, seq, sync, t, true);
+      CHECK(m.health() == LinkHealth::ok);
+      CHECK(m.counters().bus_offs == 1);
+      const bool ridden = grace > 0 && off + 1 <= grace;  // the silent restart cycle counts too
+      CHECK(faulted == !ridden);
+      CHECK(m.counters().bus_offs_ridden == (ridden ? 1u : 0u));
+    }
+  }
 }

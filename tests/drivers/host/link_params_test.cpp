@@ -51,3 +51,14 @@ TEST_CASE("bus_prefix errors name file, line and key") {
   CHECK(error_of([] { (void)dr::open_bus_from_params(parse("{bus_kind: socketcan, bus: can0, bus_prefix: auto}")); })
             .find("plugins[3].params.bus_prefix: only for bus_kind: mock") != std::string::npos);
 }
+
+TEST_CASE("the link monitor's parameters: defaults, values, and a range error naming the key") {
+  const dr::LinkMonitorConfig d = dr::monitor_from_params(parse("{bus: x}"));
+  CHECK(d.timeout_cycles == 2);
+  CHECK(d.bus_off_grace_cycles == 3);
+  CHECK(dr::monitor_from_params(parse("{bus: x, bus_off_grace_cycles: 0}")).bus_off_grace_cycles ==
+        0);
+  CHECK(error_of([] {
+          (void)dr::monitor_from_params(parse("bus: x\nbus_off_grace_cycles: -1"));
+        }).find("sim.yaml:2:23: plugins[3].params.bus_off_grace_cycles: ") == 0);
+}
