@@ -1,5 +1,6 @@
 #include "drivers/can/socketcand_protocol.h"
 
+#include <array>
 #include <cstring>
 
 namespace crease::drivers::socketcand {
@@ -13,7 +14,16 @@ int hexv(char c) noexcept {
   return -1;
 }
 
-bool is_space(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+// Whitespace separates tokens. A table, not four comparisons per character: the tokenizer
+// reads every byte of a message, and under the fuzzer each comparison is a call into it.
+constexpr auto kSpace = [] {
+  std::array<bool, 256> t{};
+  t[' '] = t['\t'] = t['\r'] = t['\n'] = true;
+  return t;
+}();
+bool is_space(char c) noexcept {
+  return kSpace[static_cast<unsigned char>(c)];
+}
 
 // Next whitespace-separated token of s starting at *pos.
 std::string_view token(std::string_view s, std::size_t* pos) noexcept {

@@ -68,6 +68,13 @@ bool SerialDeframer::end_run(SerialFrame& out) noexcept {
     return false;
   }
   if (n == 0) return false;
+  // COBS adds at least one byte: a run shorter than the smallest frame's encoding (header and
+  // CRC, no payload) cannot be a frame, and is refused without decoding it.
+  if (n < kSerialHeader + 4 + 1) {
+    ++stats_.cobs_errors;
+    stats_.bytes_discarded += n;
+    return false;
+  }
   std::uint8_t body[kSerialMaxBody];
   const long m = cobs_decode({buf_, n}, body);
   if (m < static_cast<long>(kSerialHeader + 4)) {

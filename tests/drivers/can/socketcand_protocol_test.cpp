@@ -141,3 +141,17 @@ TEST_CASE("a text longer than any message does not parse") {
   CHECK(parse_message("< echo" + std::string(kMaxMessage - 8, ' ') + ">", m));  // kMaxMessage - 1 characters
   CHECK_FALSE(parse_message("< echo" + std::string(kMaxMessage, ' ') + ">", m));
 }
+
+TEST_CASE("whitespace is space, tab, CR and LF, and no other byte") {
+  // The tokenizer classifies bytes by table: every byte value, as a separator and at the ends.
+  Message m;
+  for (int b = 0; b < 256; ++b) {
+    const char c = static_cast<char>(b);
+    const bool space = c == ' ' || c == '\t' || c == '\r' || c == '\n';
+    const std::string sep = std::string("< send") + c + "123 1" + c + "ff" + c + ">";
+    CHECK_MESSAGE((parse_message(sep, m) && m.command == Command::send) == space, b);
+    REQUIRE(parse_message(std::string("<echo") + c + ">", m));
+    CHECK_MESSAGE((m.command == Command::echo) == space, b);
+    CHECK_MESSAGE(parse_message(std::string(1, c) + "< echo >" + c, m) == space, b);
+  }
+}

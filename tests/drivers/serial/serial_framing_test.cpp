@@ -251,3 +251,60 @@ TEST_CASE("cobs_decode equals the byte-by-byte definition on valid, corrupted an
     if (trial % 3 == 0 && cap >= raw.size()) CHECK(n_got == static_cast<long>(raw.size()));
   }
 }
+
+namespace {
+// COBS encoding byte by byte (the reference the block-wise cobs_encode must equal).
+Bytes cobs_encode_by_byte(const Bytes& in) {
+  Bytes out(1);
+  std::size_t code_at = 0;
+  std::uint8_t code = 1;
+  for (std::uint8_t b : in) {
+    if (b != 0) out.push_back(b);
+    if (b == 0 || ++code == 0xFF) {
+      out[code_at] = b == 0 ? code : 0xFF;
+      code_at = out.size();
+      out.push_back(0);
+      code = 1;
+    }
+  }
+  out[code_at] = code;
+  return out;
+}
+}  // namespace
+
+TEST_CASE("cobs_encode equals the byte-by-byte definition, at and around the 254-byte blocks") {
+  std::mt19937 rng(13);
+  for (int trial = 0; trial < 3000; ++trial) {
+    Bytes raw(trial < 600 ? static_cast<std::size_t>(trial) : rng() % 1100);
+    const unsigned zero_one_in = 1 + rng() % 400;  // from mostly zeros to no zero at all
+    for (auto& b : raw)
+      b = rng() % zero_one_in == 0 ? 0 : static_cast<std::uint8_t>(1 + rng() % 255);
+    const Bytes want = cobs_encode_by_byte(raw);
+    Bytes got(cobs_max_encoded(raw.size()));
+    REQUIRE(cobs_encode(raw, got) == want.size());
+    got.resize(want.size());
+    CHECK(got == want);
+    CHECK(cobs_encode(raw, {got.data(), cobs_max_encoded(raw.size()) - 1}) == 0);  // no room
+  }
+}
+
+TEST_CASE("a run shorter than the smallest frame is a COBS error, its bytes discarded") {
+  SerialFrame f;
+  for (std::size_t n = 1; n <= kSerialHeader + 4; ++n) {
+    SerialDeframer d;
+    Bytes run(n, 0x01);
+    run.push_back(0);
+    bool got = true;
+    CHECK(d.feed(run, f, &got) == run.size());
+    CHECK_FALSE(got);
+    CHECK(d.stats().cobs_errors == 1);
+    CHECK(d.stats().bytes_discarded == n);
+  }
+  // The smallest frame itself (empty payload) still deframes.
+  SerialDeframer d;
+  const Bytes w = wire(1, 2, {});
+  bool got = false;
+  for (std::size_t k = 0; k < w.size() && !got;) k += d.feed({w.data() + k, w.size() - k}, f, &got);
+  CHECK(got);
+  CHECK(f.len == 0);
+}
