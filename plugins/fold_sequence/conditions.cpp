@@ -175,7 +175,50 @@ bool Machine::passes(Guard g, const Sensing& in) const noexcept {
   return false;
 }
 
+namespace {
+
+// The fault's source, per side (0 right, 1 left): string literals for the status's `why`.
+struct Side {
+  const char* hand_stale;
+  const char* arm_stale;
+  const char* contact_stale;
+  const char* contact_unhealthy;
+  const char* inhibit[6];  // by HandInhibit
+  const char* goal_refused;
+  const char* arm_refused;
+  const char* arm_fault;
+  const char* arm_state_stale;
+  const char* arm_aborted;
+};
+constexpr Side kSide[2] = {
+    {"hand_r status stale",
+     "arm_r status stale",
+     "contact_r status stale",
+     "contact_r unhealthy",
+     {"hand_r inhibit", "hand_r hand_state fault", "hand_r hand_state stale",
+      "hand_r tactile fault", "hand_r tactile stale", "hand_r force limit"},
+     "hand_r goal refused",
+     "arm_r goal refused",
+     "arm_r arm fault",
+     "arm_r arm_state stale",
+     "arm_r motion aborted"},
+    {"hand_l status stale",
+     "arm_l status stale",
+     "contact_l status stale",
+     "contact_l unhealthy",
+     {"hand_l inhibit", "hand_l hand_state fault", "hand_l hand_state stale",
+      "hand_l tactile fault", "hand_l tactile stale", "hand_l force limit"},
+     "hand_l goal refused",
+     "arm_l goal refused",
+     "arm_l arm fault",
+     "arm_l arm_state stale",
+     "arm_l motion aborted"},
+};
+
+}  // namespace
+
 Reason Machine::fault(const Sensing& in) noexcept {
+  detail_ = nullptr;
   const std::int64_t now = in.now_ns;
   // The sheet as vision and the model see it: stale or unobserved for longer than the bound.
   const SheetState* sh = in.sheet;
@@ -186,34 +229,52 @@ Reason Machine::fault(const Sensing& in) noexcept {
   } else if (m_.vision_bad_since_ns == 0) {
     m_.vision_bad_since_ns = now;
   } else if (static_cast<double>(now - m_.vision_bad_since_ns) * 1e-9 > spec_.vision_lost_max_s) {
+    detail_ = sh == nullptr || !fresh(sh->timestamp_ns, now, spec_.sheet_max_age_s)
+                  ? "sheet_state stale"
+                  : "sheet unobserved";
     return Reason::vision_lost;
   }
+  const auto found = [this](const char* what, Reason r) noexcept {
+    detail_ = what;
+    return r;
+  };
   for (int s = 0; s < 2; ++s) {
     const HandControlStatus* h = in.hand[s];
     const ArmMotionStatus* a = in.arm[s];
     const ContactState* c = in.contact[s];
+    const Side& n = kSide[s];
     // Controllers that do not answer, or answer that their inputs are bad: a device fault.
-    if (h == nullptr || !fresh(h->timestamp_ns, now, spec_.status_max_age_s)) return Reason::device_fault;
-    if (a == nullptr || !fresh(a->timestamp_ns, now, spec_.status_max_age_s)) return Reason::device_fault;
-    if (c == nullptr || !fresh(c->timestamp_ns, now, spec_.status_max_age_s) || c->healthy == 0)
-      return Reason::device_fault;
+    if (h == nullptr || !fresh(h->timestamp_ns, now, spec_.status_max_age_s))
+      return found(n.hand_stale, Reason::device_fault);
+    if (a == nullptr || !fresh(a->timestamp_ns, now, spec_.status_max_age_s))
+      return found(n.arm_stale, Reason::device_fault);
+    if (c == nullptr || !fresh(c->timestamp_ns, now, spec_.status_max_age_s))
+      return found(n.contact_stale, Reason::device_fault);
+    if (c->healthy == 0) return found(n.contact_unhealthy, Reason::device_fault);
     // The force controller stopped adding force since the fold began (its inhibits counter
     // rose): over its force limit, or its inputs went bad.
-    if (h->inhibits > m_.inhibits0[s] && h->inhibit != HandInhibit::none)
+    if (h->inhibits > m_.inhibits0[s] && h->inhibit != HandInhibit::none) {
+      const auto i = static_cast<std::size_t>(h->inhibit);
+      detail_ = n.inhibit[i < std::size(n.inhibit) ? i : 0];
       return h->inhibit == HandInhibit::force_limit ? Reason::force_limit : Reason::device_fault;
-    if (m_.hand_id[s] != 0 && h->goals_refused > m_.hand_refused0[s]) return Reason::goal_refused;
+    }
+    if (m_.hand_id[s] != 0 && h->goals_refused > m_.hand_refused0[s])
+      return found(n.goal_refused, Reason::goal_refused);
     const std::uint32_t id = m_.arm_id[s];
     if (id == 0) continue;
     if (a->last_refused_id == id || (a->goal_id == id && (a->state == ArmMotionStatus::unreachable ||
                                                           a->state == ArmMotionStatus::refused))) {
       const auto why = static_cast<ArmMotionReason>(end_reason(*a, id));
-      return why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed ? Reason::unreachable
-                                                                                         : Reason::goal_refused;
+      return found(n.arm_refused,
+                   why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed
+                       ? Reason::unreachable
+                       : Reason::goal_refused);
     }
     if (a->goal_id == id && a->state == ArmMotionStatus::aborted) {
       const auto why = static_cast<ArmMotionReason>(a->reason);
-      return why == ArmMotionReason::arm_fault || why == ArmMotionReason::arm_stale ? Reason::device_fault
-                                                                                     : Reason::motion_aborted;
+      if (why == ArmMotionReason::arm_fault) return found(n.arm_fault, Reason::device_fault);
+      if (why == ArmMotionReason::arm_stale) return found(n.arm_state_stale, Reason::device_fault);
+      return found(n.arm_aborted, Reason::motion_aborted);
     }
   }
   return Reason::none;

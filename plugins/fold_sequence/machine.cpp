@@ -14,6 +14,15 @@ void copy_text(char* dst, std::size_t n, const char* a, const char* b = nullptr)
   dst[at] = '\0';
 }
 
+// "abort: <reason>" or "abort: <reason>: <detail>" (e.g. "abort: device_fault: contact_r
+// unhealthy").
+void abort_why(char* dst, std::size_t n, const char* reason, const char* detail) noexcept {
+  copy_text(dst, n, "abort: ", reason);
+  if (detail == nullptr) return;
+  const std::size_t at = std::strlen(dst);
+  copy_text(dst + at, n - at, ": ", detail);
+}
+
 S common_ancestor(S a, S b) noexcept {
   for (S x = a;; x = state_info(x).parent) {
     if (is_within(b, x)) return x;
@@ -73,11 +82,11 @@ void Machine::fill_status(SequenceStatus& s, std::int64_t now_ns) const noexcept
   } else if (m_.last_row >= 0 && m_.last_row < rows.end - rows.begin) {
     const Row& r = rows.begin[m_.last_row];
     if (r.ev == Ev::fault || r.from == S::fold)
-      copy_text(s.why, sizeof s.why, "abort: ", reason_name(m_.last_reason));
+      abort_why(s.why, sizeof s.why, reason_name(m_.last_reason), abort_detail_);
     else
       copy_text(s.why, sizeof s.why, r.why);
   } else if (m_.last_reason != Reason::none) {
-    copy_text(s.why, sizeof s.why, "abort: ", reason_name(m_.last_reason));
+    abort_why(s.why, sizeof s.why, reason_name(m_.last_reason), abort_detail_);
   }
   if (m_.start_pending && !is_within(m_.leaf, S::fold) && !is_within(m_.leaf, S::abort))
     copy_text(s.why, sizeof s.why, "start: waiting for the controllers and the sheet");
@@ -113,8 +122,11 @@ void Machine::go(S to, Reason r, int row, const Sensing& in, Outbox& out) noexce
   m_.gate_row = -1;
   m_.paused = 0;
   ++m_.transitions;
-  if (r != Reason::condition && r != Reason::started && is_within(to, S::abort) && !is_within(from, S::abort))
+  if (r != Reason::condition && r != Reason::started && is_within(to, S::abort) &&
+      !is_within(from, S::abort)) {
     m_.abort_reason = r;
+    abort_detail_ = row >= 0 && all_rows().begin[row].ev == Ev::fault ? detail_ : nullptr;
+  }
   m_.self_entry = self ? 1 : 0;
   S x = to;
   for (int i = k - 1; i >= 0; --i) {
@@ -186,6 +198,7 @@ void Machine::step(const Sensing& in, Outbox& out) noexcept {
   }
   const bool folding = is_within(m_.leaf, S::fold);
   detected_ = Reason::none;
+  detail_ = nullptr;
   if (folding) {
     detected_ = external_fault_ != Reason::none ? external_fault_ : fault(in);
     external_fault_ = Reason::none;

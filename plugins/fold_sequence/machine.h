@@ -202,6 +202,10 @@ class Machine {
   Command command_ = Command::none;
   Reason external_fault_ = Reason::none;
   Reason detected_ = Reason::none;  // the fault found this cycle (the fault row's reason)
+  // Which input the fault came from, e.g. "contact_r unhealthy" (a string literal; null: none).
+  // detail_: this cycle's; abort_detail_: the one that started the abort (not kept by a swap).
+  const char* detail_ = nullptr;
+  const char* abort_detail_ = nullptr;
 };
 
 // A hash of what a Memory depends on in the fold (its name, via points, sides), for load_state.

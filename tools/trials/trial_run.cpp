@@ -112,9 +112,18 @@ void judge(TrialResult& r) {
   if (!r.error.empty()) {
     r.failure = "error: " + r.error;
   } else if (r.end != "done") {
-    r.failure = r.end == "not_started" ? "not started (the start's guard never passed)"
-                                       : (r.end == "time_limit" ? "time limit in " : "aborted in ") + r.last_fold_state +
-                                             (r.abort_reason.empty() ? "" : ": " + r.abort_reason);
+    // The reason with the input it came from when the sequence named one: the why of its first
+    // abort transition, "abort: device_fault: contact_r unhealthy".
+    std::string reason = r.abort_reason;
+    for (const TimelineEntry& e : r.timeline)
+      if (e.why.rfind("abort: " + r.abort_reason, 0) == 0 && !r.abort_reason.empty()) {
+        reason = e.why.substr(7);
+        break;
+      }
+    r.failure = r.end == "not_started"
+                    ? "not started (the start's guard never passed)"
+                    : (r.end == "time_limit" ? "time limit in " : "aborted in ") +
+                          r.last_fold_state + (reason.empty() ? "" : ": " + reason);
   } else if (!r.score.shape_ok) {
     r.failure = r.score.miss;
   } else if (!r.hands_clear) {
@@ -249,11 +258,14 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
           }
           continue;
         }
-        if (!operator_abort && since(started_ns) > o.max_fold_s) {
+        // The time limit: the operator aborts a fold still running (one that aborted by itself
+        // is retreating already and keeps its own reason); any retreat gets kAbortWaitS more.
+        if (!operator_abort && s.phase != SequenceStatus::aborted &&
+            since(started_ns) > o.max_fold_s) {
           host.set_param(fold, "command", 4.0);  // creasectl sequence abort: the safe retreat
           operator_abort = true;
         }
-        if (operator_abort && since(started_ns) > o.max_fold_s + kAbortWaitS) {
+        if (since(started_ns) > o.max_fold_s + kAbortWaitS) {
           r.end = "time_limit";
           r.error = "the abort's retreat did not end";
           break;
