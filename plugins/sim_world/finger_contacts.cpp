@@ -56,6 +56,7 @@ void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const W
   grid_h_ = g.h;
   du_ = g.du;
   dv_ = g.dv;
+  patch_reach_ = 0.5 * std::hypot(du_, dv_);
   half_thickness_ = 0.5 * sheet.params().grid.thickness_mm;
   const int n = sheet.node_count();
   const double kg_per_mm2 = sheet.params().grid.areal_density_g_per_m2 * 1e-9;
@@ -224,6 +225,12 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
     const int si = t.shape[e];
     const WorldShape& s = shapes_[si];
     const Pose& pose = pose_now_[si];
+    // Most candidates of a step are out of reach in a given substep (77 % in crease-bench
+    // world's scenes): a lower bound on the patch's distance from the shape (the node's from the
+    // core, less the shape's growth and the patch's reach) rules most of those out before the
+    // patch's deepest point is sought (three core projections and a surface query).
+    if (norm(closest_core(s.geom, pose, p) - p) - core_grow(s.geom) - patch_reach_ >= half_thickness_ + kInactiveReachMm)
+      continue;
     const Geometry geo = geometry(s, pose, t, p);
     if (geo.pen <= -kInactiveReachMm) continue;
     // Shapes of one rigid body (a fingertip's cover, pad and back) overlap: a node inside two

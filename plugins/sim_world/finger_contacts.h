@@ -154,6 +154,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   int n_shapes_ = 0;
   int grid_w_ = 0, grid_h_ = 0;
   double du_ = 0, dv_ = 0, half_thickness_ = 0.5;
+  double patch_reach_ = 0;  // mm: a patch's farthest point from its node (half its cell's diagonal)
   std::vector<double> node_area_mm2_;
   std::vector<std::int32_t> slot_of_node_;  // -1: not touched this step
   std::vector<Touched> touched_;

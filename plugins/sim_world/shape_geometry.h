@@ -151,6 +151,13 @@ inline Vec3 closest_core(const Geom& g, const Pose& pose, Vec3 p) noexcept {
   return pose.apply(c);
 }
 
+// How far the shape reaches beyond its core (closest_core): |p - core| minus it is a lower bound
+// on p's distance from the shape, exact for a sphere, a capsule and a (rounded) box; a cylinder
+// lies within the capsule of its radius. mm. RT.
+inline double core_grow(const Geom& g) noexcept {
+  return g.kind == GeomKind::box ? std::min({g.half_mm.x, g.half_mm.y, g.half_mm.z}) : g.radius_mm;
+}
+
 // The shape's lowest world point (smallest z) and the shape's extent in world x, y, z. RT.
 inline Vec3 lowest_point(const Geom& g, const Pose& pose) noexcept {
   // The local direction of world -z is the third row of R, negated.

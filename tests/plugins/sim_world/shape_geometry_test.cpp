@@ -4,6 +4,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -104,5 +105,29 @@ TEST_CASE("the lowest point and the bounding box hold every kind, turned") {
         CHECK(std::fabs(c) <= half_extent(g, pose, a) + 1e-9);
       }
     }
+  }
+}
+
+TEST_CASE("the core's distance less core_grow bounds the distance to every kind from below, exactly but for a cylinder") {
+  const Geom geoms[] = {{GeomKind::sphere, 4, 0, {}}, {GeomKind::capsule, 2, 6, {}}, {GeomKind::cylinder, 3, 5, {}},
+                        {GeomKind::box, 0, 0, {9, 7, 1}}};
+  const Pose pose = turned_x(0.7, {1, 2, 30});
+  for (const Geom& g : geoms) {
+    CAPTURE(static_cast<int>(g.kind));
+    double loosest = 0;
+    for (int i = 0; i < 400; ++i) {
+      const double th = std::numbers::pi * (i % 20) / 19.0, ph = 2 * std::numbers::pi * (i / 20) / 20.0;
+      const Vec3 dir{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+      for (double r : {0.5, 3.0, 8.0, 20.0}) {  // inside some kinds, on their surface, outside
+        const Vec3 p = pose.t + r * dir;
+        const double bound = norm(closest_core(g, pose, p) - p) - core_grow(g);
+        const double d = closest_surface(g, pose, p).distance_mm;
+        if (d < 0) continue;  // inside: the bound is for points outside (the contacts' skip)
+        CHECK(bound <= d + 1e-9);
+        loosest = std::max(loosest, d - bound);
+      }
+    }
+    if (g.kind == GeomKind::cylinder) CHECK(loosest > 0.1);  // its rim is inside the capsule
+    else CHECK(loosest < 1e-9);
   }
 }
