@@ -11,8 +11,9 @@
 // Not in the scenes yet: a fold and a crease. MuJoCo's grid cloth has no bending stiffness and no
 // plasticity (its particles are joined by length constraints only), so it cannot keep a crease.
 //
-//   crease-bench world [--quick] [--mj-solver CG|PGS|Newton] [--mj-iterations N] [--cpu K]
+//   crease-bench world [--quick] [--ours-only] [--mj-solver CG|PGS|Newton] [--mj-iterations N] [--cpu K]
 // --quick: press_drag's first 1.7 simulated seconds (descent and press) only.
+// --ours-only: MuJoCo not run (to profile ours); the last line then carries ours alone.
 // Last line: world: ours_rtf=... mujoco_rtf=... ratio=... drag_mm=ours/mujoco pinch_rise_mm=...
 #include <pthread.h>
 #include <sched.h>
@@ -133,6 +134,7 @@ std::vector<std::string> figure_names(const Script& sc) {
 
 int run_world(int argc, char** argv) {
   const bool quick = bench::has_flag(argc, argv, "--quick");
+  const bool ours_only = bench::has_flag(argc, argv, "--ours-only");
   MujocoOptions mo;
   for (int i = 1; i + 1 < argc; ++i)
     if (std::strcmp(argv[i], "--mj-solver") == 0) mo.solver = argv[i + 1];
@@ -156,6 +158,11 @@ int run_world(int argc, char** argv) {
     std::vector<MirroredShape> mirror;
     double table_mu = 0;
     const SheetRun ours = run_ours(model, sc, mirror, table_mu);
+    if (ours_only) {
+      ours_wall += ours.wall_s;
+      simulated += ours.simulated_s;
+      continue;
+    }
     SheetRun theirs;
     mo.sheet_thickness_mm = sc.params.sheet.grid.thickness_mm;
     if (!run_mujoco(sc, mirror, table_mu, mo, theirs)) return 1;
@@ -170,6 +177,10 @@ int run_world(int argc, char** argv) {
     std::printf("  %-46s %9s %9s\n", "end state", "ours", "mujoco");
     for (std::size_t i = 0; i < names.size(); ++i)
       std::printf("  %-46s %9.2f %9.2f\n", names[i].c_str(), ours_f.back()[i], theirs_f.back()[i]);
+  }
+  if (ours_only) {
+    std::printf("world: ours_rtf=%.2f mujoco_rtf=n/a (--ours-only)\n", simulated / ours_wall);
+    return 0;
   }
   const double ours_rtf = simulated / ours_wall, theirs_rtf = simulated / theirs_wall;
   std::printf("both scenes: %.2f simulated s; ours %.2f s (rtf %.2f), mujoco %.2f s (rtf %.3f)\n", simulated, ours_wall,
