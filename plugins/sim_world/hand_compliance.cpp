@@ -42,6 +42,8 @@ bool cholesky_solve(double a[kN][kN], double b[kN]) noexcept {
 void HandCompliance::configure(const Limits& limits, int max_contacts) {
   limits_ = limits;
   g_.assign(static_cast<std::size_t>(std::max(0, max_contacts)), Joints{});
+  nz_.assign(g_.size(), {});
+  n_nz_.assign(g_.size(), 0);
   on_.assign(g_.size(), 0);
   g_old_.assign(g_.size(), 0.0);
   truncated_ = 0;
@@ -61,6 +63,10 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     kin.add_hand_jacobian_transpose(contacts[c].link, contacts[c].point, contacts[c].normal, g_[c]);
     if (contacts[c].link2 >= 0)
       kin.add_hand_jacobian_transpose(contacts[c].link2, contacts[c].point2, contacts[c].normal2, g_[c]);
+    int n = 0;
+    for (int j = 0; j < kN; ++j)
+      if (g_[c][j] != 0.0) nz_[c][n++] = static_cast<std::uint8_t>(j);
+    n_nz_[c] = static_cast<std::uint8_t>(n);
   }
   saturated_ = 0;
   at_limit_ = 0;
@@ -73,7 +79,7 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   double* g_old = g_old_.data();  // g_c . dq_old per contact: fixed for the solve
   for (int c = 0; c < nc; ++c) {
     g_old[c] = 0;
-    for (int j = 0; j < kN; ++j) g_old[c] += g_[c][j] * old[j];
+    for (int k = 0; k < n_nz_[c]; ++k) g_old[c] += g_[c][nz_[c][k]] * old[nz_[c][k]];
   }
   // The box each joint's deflection stays in: its limits, and within max_step_rad of the last.
   double lo[kN], hi[kN], k_full[kN], tmax[kN], k_eff[kN];
@@ -87,7 +93,10 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   // Depth of contact c at deflection d, linearised about the step's.
   auto depth = [&](int c, const double* d) {
     double v = contacts[c].depth_mm;
-    for (int j = 0; j < kN; ++j) v += g_[c][j] * (d[j] - old[j]);
+    for (int k = 0; k < n_nz_[c]; ++k) {
+      const int j = nz_[c][k];
+      v += g_[c][j] * (d[j] - old[j]);
+    }
     return v;
   };
   // The potential the balance minimises (N mm): the springs (quadratic up to the effort, linear
@@ -128,7 +137,7 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     for (int c = 0; c < nc; ++c) {
       if (!on[c]) continue;
       const double f = contacts[c].stiffness_n_per_mm * depth(c, cur);
-      for (int j = 0; j < kN; ++j) grad[j] += f * g_[c][j];
+      for (int k = 0; k < n_nz_[c]; ++k) grad[nz_[c][k]] += f * g_[c][nz_[c][k]];
     }
     // A joint at a bound stays there while the potential falls beyond it.
     for (int j = 0; j < kN; ++j) locked[j] = (cur[j] <= lo[j] + kAtBoundRad && grad[j] > 0) || (cur[j] >= hi[j] - kAtBoundRad && grad[j] < 0);
@@ -144,11 +153,11 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
       if (!on[c]) continue;
       const double kc = contacts[c].stiffness_n_per_mm;
       const double rc = -kc * (contacts[c].depth_mm - g_old[c]);
-      for (int i = 0; i < kN; ++i) {
+      for (int a = 0; a < n_nz_[c]; ++a) {
+        const int i = nz_[c][a];
         const double gi = g_[c][i];
-        if (gi == 0.0) continue;
         r0[i] += rc * gi;
-        for (int j = 0; j < kN; ++j) a0[i][j] += kc * gi * g_[c][j];
+        for (int b = 0; b < n_nz_[c]; ++b) a0[i][nz_[c][b]] += kc * gi * g_[c][nz_[c][b]];
       }
     }
     // The Newton step over the free joints. A free joint at a bound that the step would take

@@ -82,6 +82,10 @@ class HandCompliance {
  private:
   Limits limits_;
   std::vector<Joints> g_;          // J^T n per contact, mm/rad
+  // Per contact: the joints its g_ row moves (a fingertip's chain, 4-5 of the 20), in order:
+  // the sums over them are the full rows' sums, bit for bit (the rest add exact zeros).
+  std::vector<std::array<std::uint8_t, kJoints>> nz_;
+  std::vector<std::uint8_t> n_nz_;
   std::vector<std::uint8_t> on_;  // per contact: pushing in the current round
   std::vector<double> g_old_;     // per contact: g . dq_old (mm), fixed for a solve
   std::uint64_t truncated_ = 0;
