@@ -29,6 +29,8 @@ TrackerParams tracker_params_from(const crease::Params& p) {
   t.full_support = p.get_in_range<double>("full_support", t.full_support, 1e-6, 1e6);
   t.visibility_scale = p.get_in_range<int>("visibility_scale", t.visibility_scale, 1, 64);
   t.visibility_cells = p.get_in_range<int>("visibility_cells", t.visibility_cells, 0, 64);
+  t.occluder_mm = p.get_in_range<double>("occluder_mm", t.occluder_mm, 0.0, 1e4);
+  t.occlusion_margin = p.get_in_range<int>("occlusion_margin", t.occlusion_margin, 0, 64);
   t.use_visibility = p.get<bool>("visibility", true);
   t.nodes_u = p.get_in_range<int>("nodes_u", t.nodes_u, 2, 64);
   t.nodes_v = p.get_in_range<int>("nodes_v", t.nodes_v, 2, 64);
@@ -54,11 +56,25 @@ void DepthTracker::configure(const TrackerParams& p, const std::vector<vision::D
           Eigen::Vector2d(i * p.width_mm / (p.nodes_u - 1), j * p.height_mm / (p.nodes_v - 1));
   cpd_.configure(p.cpd, uv_, p.max_points, p.kernel_rank, 1e-7, p.kernel_cut);
   vis_.configure(cams, p.nodes_u, p.nodes_v, p.visibility_scale, p.visibility_cells);
+  vis_.set_depth_check(cp.camera_depth_unit_mm, p.occluder_mm);
   nodes_.assign(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
   out_ = nodes_;
   support_.assign(static_cast<std::size_t>(n), 0.0);
   seen_.assign(static_cast<std::size_t>(n), 0u);
   active_.assign(static_cast<std::size_t>(n), 0);
+  near_hidden_.assign(static_cast<std::size_t>(n), 0);
+}
+
+void DepthTracker::mark_hidden_margin() noexcept {
+  const int nu = params_.nodes_u, nv = params_.nodes_v, m = params_.occlusion_margin;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      bool near = false;
+      for (int b = std::max(0, j - m); b <= std::min(nv - 1, j + m) && !near; ++b)
+        for (int a = std::max(0, i - m); a <= std::min(nu - 1, i + m) && !near; ++a)
+          near = active_[static_cast<std::size_t>(b * nu + a)] == 0;
+      near_hidden_[static_cast<std::size_t>(j * nu + i)] = near ? 1 : 0;
+    }
 }
 
 bool DepthTracker::process(std::span<const cv::Mat> depth, std::span<const cv::Mat> bgr, const SheetState& model,
@@ -90,7 +106,7 @@ bool DepthTracker::process(std::span<const cv::Mat> depth, std::span<const cv::M
         Eigen::Vector3d(model.position_mm[i][0], model.position_mm[i][1], model.position_mm[i][2]);
   int visible = 0;
   if (params_.use_visibility) {
-    (void)vis_.compute(nodes_, out.cameras_ok, seen_);
+    (void)vis_.compute(nodes_, out.cameras_ok, seen_, depth.first(ncam));
     for (int i = 0; i < n; ++i) visible += (active_[static_cast<std::size_t>(i)] = seen_[static_cast<std::size_t>(i)] != 0 ? 1 : 0);
   } else {
     std::fill(active_.begin(), active_.end(), std::uint8_t{1});
@@ -103,9 +119,12 @@ bool DepthTracker::process(std::span<const cv::Mat> depth, std::span<const cv::M
   out.iterations = static_cast<std::uint32_t>(last_.iterations);
   out.sigma2_mm2 = static_cast<float>(last_.sigma2_mm2);
   if (!last_.ok) return false;
+  mark_hidden_margin();
   for (int i = 0; i < n && out.count < DepthTargets::kCapacity; ++i) {
     const auto s = static_cast<std::size_t>(i);
-    if (!active_[s] || !(support_[s] >= params_.min_support) || !(support_[s] > 0.0)) continue;
+    if (!active_[s] || near_hidden_[s] || !(support_[s] >= params_.min_support) ||
+        !(support_[s] > 0.0))
+      continue;
     DepthTargets::Point& p = out.points[out.count++];
     for (int c = 0; c < 3; ++c) p.world_mm[c] = static_cast<float>(out_[s][c]);
     p.sheet_mm[0] = static_cast<float>(uv_[s][0]);

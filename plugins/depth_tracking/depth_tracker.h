@@ -1,10 +1,14 @@
 // One depth frame set through the depth path (seed 001 Sec. III-B, issue 17): colour mask and
 // valid depth -> world cloud of every camera that delivered (point_cloud.h), voxel-downsampled;
-// the model nodes some camera sees (visibility.h) as CPD's active centroids, registered onto the
-// cloud (sheet_cpd.h, warm start from the model's newest state); then one target per active node
-// with posterior support P1 >= min_support: the registered position, weight min(1, P1 /
-// full_support). The sheet model pulls each along its normal (DepthTargets, sheet_model).
-// No threads here (depth_worker.h runs it on one); configure() allocates, process() does not.
+// the model nodes some camera sees (visibility.h: the model's own layers z-buffered, and no
+// measured surface more than occluder_mm in front of the node) as CPD's active centroids,
+// registered onto the cloud (sheet_cpd.h, warm start from the model's newest state); then one
+// target per active node with posterior support P1 >= min_support and no hidden node within
+// occlusion_margin grid steps (next to a hidden part a node's points all lie on the seen side, and
+// CPD moves it there: such targets dragged an occluded lower layer towards its part still seen):
+// the registered position, weight min(1, P1 / full_support). The sheet model pulls each along its
+// normal (DepthTargets, sheet_model). No threads here (depth_worker.h runs it on one); configure()
+// allocates, process() does not.
 #pragma once
 
 #include <cstdint>
@@ -34,15 +38,18 @@ struct TrackerParams {
   double full_support = 4.0;    // P1 of a weight-1 target
   int visibility_scale = 4;     // the visibility buffers' resolution divisor
   int visibility_cells = 1;      // a node's pixels may show cells this many steps from its own
+  double occluder_mm = 10.0;    // a measured surface this much nearer than a node hides it (0: off)
+  int occlusion_margin = 1;     // no target within this many grid steps of a hidden node
   bool use_visibility = true;   // false: every node is a centroid (the baseline's layer mix-up)
   int nodes_u = 15, nodes_v = 21;
   double width_mm = 210.0, height_mm = 297.0;
 };
 
 // Plugin parameters (keys: mask {h_lo h_hi s_lo s_hi v_lo v_hi}, voxel_mm, min_depth_mm,
-// max_depth_mm, max_points, cpd {cpd_params.h's keys}, kernel_rank, kernel_cut, min_support, full_support,
-// visibility_scale, visibility_cells, visibility, nodes_u, nodes_v, width_mm, height_mm); every
-// range error a ConfigError naming file, line and key.
+// max_depth_mm, max_points, cpd {cpd_params.h's keys}, kernel_rank, kernel_cut, min_support,
+// full_support, visibility_scale, visibility_cells, occluder_mm, occlusion_margin, visibility,
+// nodes_u, nodes_v, width_mm, height_mm); every range error a ConfigError naming file, line and
+// key.
 TrackerParams tracker_params_from(const crease::Params& p);
 
 struct FrameTiming {
@@ -69,6 +76,8 @@ class DepthTracker {
   [[nodiscard]] const TrackerParams& params() const noexcept { return params_; }
 
  private:
+  void mark_hidden_margin() noexcept;  // near_hidden_ from active_; no allocation
+
   TrackerParams params_;
   CloudBuilder cloud_;
   SheetCpd cpd_;
@@ -78,6 +87,7 @@ class DepthTracker {
   std::vector<double> support_;
   std::vector<std::uint32_t> seen_;
   std::vector<std::uint8_t> active_;
+  std::vector<std::uint8_t> near_hidden_;  // per node: within occlusion_margin of a hidden node
   CpdResult last_;
   FrameTiming timing_;
 };

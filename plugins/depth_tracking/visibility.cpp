@@ -15,6 +15,10 @@ void check(bool ok, const char* key, const std::string& reason) {
 }
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// Half-width, in full-resolution pixels, of the window the depth check reads around a node's
+// pixel: the node is hidden only if no pixel of it sees as far as the node (a node at the edge of
+// an occluder stays seen; the 1 mm depth noise and holes do not hide one).
+constexpr int kDepthWindow = 2;
 
 }  // namespace
 
@@ -27,6 +31,9 @@ void NodeVisibility::configure(const std::vector<vision::Camera>& cameras, int n
   nu_ = nodes_u;
   nv_ = nodes_v;
   cells_ = cells;
+  scale_ = scale;
+  unit_mm_.assign(cameras.size(), 1.0);
+  occluder_mm_ = 0.0;
   views_.clear();
   for (const vision::Camera& c : cameras) {
     View v;
@@ -48,11 +55,36 @@ void NodeVisibility::configure(const std::vector<vision::Camera>& cameras, int n
   proj_.assign(static_cast<std::size_t>(nu_) * static_cast<std::size_t>(nv_), Eigen::Vector3d::Zero());
 }
 
+void NodeVisibility::set_depth_check(const std::vector<double>& depth_unit_mm, double occluder_mm) {
+  check(depth_unit_mm.size() == views_.size(), "cameras", "one depth unit per camera");
+  check(occluder_mm >= 0.0 && std::isfinite(occluder_mm), "occluder_mm", "must be finite and >= 0");
+  for (const double u : depth_unit_mm)
+    check(u > 0.0 && std::isfinite(u), "depth_unit_mm", "must be > 0");
+  unit_mm_ = depth_unit_mm;
+  occluder_mm_ = occluder_mm;
+}
+
+double NodeVisibility::farthest_depth_mm(const cv::Mat& depth, double unit_mm, double x,
+                                         double y) const noexcept {
+  const int cx = static_cast<int>(std::lround(x)), cy = static_cast<int>(std::lround(y));
+  std::uint16_t far = 0;
+  for (int yy = std::max(0, cy - kDepthWindow); yy <= std::min(depth.rows - 1, cy + kDepthWindow);
+       ++yy) {
+    const auto* row = depth.ptr<std::uint16_t>(yy);
+    for (int xx = std::max(0, cx - kDepthWindow); xx <= std::min(depth.cols - 1, cx + kDepthWindow);
+         ++xx)
+      far = std::max(far, row[xx]);
+  }
+  return far * unit_mm;
+}
+
 bool NodeVisibility::compute(std::span<const Eigen::Vector3d> nodes, std::uint32_t mask,
-                             std::span<std::uint32_t> seen) noexcept {
+                             std::span<std::uint32_t> seen,
+                             std::span<const cv::Mat> depth) noexcept {
   const std::size_t n = proj_.size();
   if (nodes.size() != n || seen.size() != n) return false;
   std::fill(seen.begin(), seen.end(), 0u);
+  occluded_ = 0;
   for (std::size_t k = 0; k < views_.size(); ++k) {
     if (((mask >> k) & 1u) == 0) continue;
     View& v = views_[k];
@@ -101,6 +133,9 @@ bool NodeVisibility::compute(std::span<const Eigen::Vector3d> nodes, std::uint32
         raster(proj_[p00], proj_[p10], proj_[p01], cell);
         raster(proj_[p10], proj_[p11], proj_[p01], cell);
       }
+    const cv::Mat* dimg = nullptr;
+    if (occluder_mm_ > 0.0 && k < depth.size() && !depth[k].empty() && depth[k].type() == CV_16UC1)
+      dimg = &depth[k];
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d& p = proj_[i];
       if (p[2] <= 0) continue;
@@ -120,7 +155,17 @@ bool NodeVisibility::compute(std::span<const Eigen::Vector3d> nodes, std::uint32
           const int dj = cj < nj - 1 ? nj - 1 - cj : (cj > nj ? cj - nj : 0);
           own = std::max(di, dj) <= cells_;
         }
-      if (own) seen[i] |= 1u << k;
+      if (!own) continue;
+      if (dimg != nullptr) {
+        // The scaled pixel back at full resolution (the inverse of configure's scaling of K).
+        const double far = farthest_depth_mm(*dimg, unit_mm_[k], (p[0] + 0.5) * scale_ - 0.5,
+                                             (p[1] + 0.5) * scale_ - 0.5);
+        if (far > 0.0 && far < p[2] - occluder_mm_) {
+          ++occluded_;
+          continue;
+        }
+      }
+      seen[i] |= 1u << k;
     }
   }
   return true;

@@ -34,11 +34,13 @@ struct TargetPoint {
 
 // A depth target: sheet point `sheet_mm` pulled towards `world_mm` by a zero-length spring of
 // stiffness scaled by `weight` (0, 1], along the model's normal at that point when the solver's
-// depth_along_normal is set (the depth path: plugins/depth_tracking).
+// depth_along_normal is set (the depth path: plugins/depth_tracking); with depth_surface_normal
+// and a known `surface_normal`, along the bisector of the two.
 struct NormalTarget {
   Vec3 world_mm;
   Vec2 sheet_mm;
   double weight = 1.0;
+  Vec3 surface_normal{};  // unit normal of the observed surface there (zero: not known)
 };
 
 struct Region {

@@ -24,7 +24,9 @@
 // depth_compliance_m_per_n (a depth target of weight 1), depth_along_normal (default true: depth
 // targets pull along the model's normal only; false: 3-D springs), depth_predict (default false:
 // a depth target moves on at its node's velocity between the last two depth frames),
-// depth_tangential_weight (0.3: the share of the tangential error a depth target corrects).
+// depth_tangential_weight (0.3: the share of the tangential error a depth target corrects),
+// depth_surface_normal (default true: a depth target pulls along the bisector of the model's
+// normal and the observed surface's, estimated from the targets of its grid neighbours).
 
 #include <memory>
 #include <string>
@@ -64,6 +66,7 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.depth_compliance_m_per_n = p.get_in_range<double>("depth_compliance_m_per_n", 0.05, 0.0, 1e6);
     sp.solver.depth_along_normal = p.get<bool>("depth_along_normal", true);
     sp.solver.depth_tangential_weight = p.get_in_range<double>("depth_tangential_weight", 0.3, 0.0, 1.0);
+    sp.solver.depth_surface_normal = p.get<bool>("depth_surface_normal", true);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
     sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
     sp.solver.yield_strain = p.get_in_range<double>("yield_strain", sp.solver.yield_strain, 0.0, 1.0);

@@ -99,6 +99,11 @@ struct SolverParams {
   // normal only; 1: a 3-D spring). Depth says little about where along the surface a point lies,
   // but not nothing (the sheet's edges): without any of it the sheet slides as the flap turns.
   double depth_tangential_weight = 0.3;
+  // With depth_along_normal: a target that carries the observed surface's normal (NormalTarget::
+  // surface_normal) pulls along the bisector of it and the model's normal. Along the model's
+  // normal alone, a flap that turns ahead of the model is pushed out along its tangent each frame
+  // (its hinge rises off the crease); along the bisector the pull follows the chord of the turn.
+  bool depth_surface_normal = true;
   // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
   double friction = 0.5;
   bool self_collision = true;

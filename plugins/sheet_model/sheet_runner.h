@@ -40,6 +40,8 @@ class SheetRunner {
   // the velocity between the two, for at most kDepthMaxPredictS (depth frames come at a few Hz
   // to 30 Hz; the model steps at 60 Hz) when set_depth_prediction(true) (off by default: in real
   // loops a late set extrapolated for long overshoots; measured in the depth_tracking plugin test).
+  // Each target on a grid node gets the observed surface's normal from its neighbours' targets
+  // (NormalTarget::surface_normal).
   void set_depth_targets(const DepthTargets& t) noexcept;
   void set_depth_prediction(bool on) noexcept { depth_predict_ = on; }
   static constexpr double kDepthMaxAgeS = 1.5;
@@ -75,6 +77,7 @@ class SheetRunner {
   std::vector<NormalTarget> depth_;  // capacity DepthTargets::kCapacity
   std::vector<NormalTarget> depth_used_targets_;  // depth_ predicted to the step's time
   std::vector<std::int32_t> depth_node_;          // per target: its grid node, -1: none
+  std::vector<std::int32_t> node_depth_;          // per node: its target in depth_, -1: none
   std::vector<Vec3> node_last_, node_vel_;         // per node: last depth target, its velocity
   std::vector<std::int64_t> node_last_ns_;         // per node: when (INT64_MIN: never)
   bool depth_predict_ = false;

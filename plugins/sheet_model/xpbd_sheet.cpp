@@ -152,14 +152,16 @@ void XpbdSheet::project_targets() noexcept {
   }
 }
 
-// Depth targets: seed 001 Eq. 4 on the sheet point c = sum b_e x_e, projected on the model's
-// unit normal n there (taken at the frame's start): with d = c - x_d split into its normal part
-// n (n . d) and the rest, x_e -= w_e b_e (n (n . d) + t (d - n (n . d))) / (sum w_e b_e^2 +
-// alpha / (weight dt_s^2)), t = depth_tangential_weight. Without depth_along_normal, the 3-D
-// spring of project_targets with that compliance.
+// Depth targets: seed 001 Eq. 4 on the sheet point c = sum b_e x_e, projected on the unit normal
+// n there (taken at the frame's start: the model's, or with depth_surface_normal the bisector of
+// the model's and the observed surface's when the target knows it): with d = c - x_d split into its
+// normal part n (n . d) and the rest, x_e -= w_e b_e (n (n . d) + t (d - n (n . d))) / (sum w_e
+// b_e^2 + alpha / (weight dt_s^2)), t = depth_tangential_weight. Without depth_along_normal, the
+// 3-D spring of project_targets with that compliance.
 void XpbdSheet::prepare_normal_targets(double dt_s) noexcept {
   if (n_normal_targets_ == 0) return;
   const bool along = params_.solver.depth_along_normal;
+  const bool surface = params_.solver.depth_surface_normal;
   if (along) compute_normals(node_normals_);
   const double a = params_.solver.depth_compliance_m_per_n / (dt_s * dt_s);
   for (int t = 0; t < n_normal_targets_; ++t) {
@@ -174,6 +176,10 @@ void XpbdSheet::prepare_normal_targets(double dt_s) noexcept {
       den += r.wb[e] * s.bilinear[e];
       if (along) n += s.bilinear[e] * node_normals_[s.node[e]];
     }
+    const Vec3 ns = normal_targets_[t].surface_normal;
+    const double mn = norm(n);
+    if (along && surface && norm(ns) > 0.5 && mn > 1e-9)
+      n = (1.0 / mn) * n + (dot(ns, n) >= 0 ? 1.0 : -1.0) * ns;
     const double nn = norm(n);
     r.normal = along && nn > 1e-9 ? (1.0 / nn) * n : Vec3{};
     r.inv_den = den > 0 && (!along || nn > 1e-9) ? 1.0 / den : 0.0;
