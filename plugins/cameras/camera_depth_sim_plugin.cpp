@@ -7,9 +7,11 @@
 // Parameters: cameras: DIR (cam0.yaml.. with depth_unit_mm), sheet: plain | markers (layout:
 // for markers), sheet_colour: {b, g, r} (plain), seed, noise (grey levels), blur_px, occluders,
 // frame_period_s, depth_noise (bool), baseline_mm, subpixel, max_incidence_deg, edge_jump_mm,
-// min_range_mm, max_range_mm, table_z_mm, hand_height_mm; and camera_plugin.h's (no `record`:
-// depth has no replay layout yet).
-// Inputs: sheet_truth (crease::SheetState). Outputs: depth_images (frames), depth_frames.
+// min_range_mm, max_range_mm, table_z_mm, hand_height_mm (the random occluders'), world_shapes
+// (bool, default false: the world's arms and hands of the `world_shapes` port at their real
+// depth, skin-coloured); and camera_plugin.h's (no `record`: depth has no replay layout yet).
+// Inputs: sheet_truth (crease::SheetState), world_shapes (crease::WorldShapes, with
+// `world_shapes: true`). Outputs: depth_images (frames), depth_frames.
 #include <memory>
 
 #include "core/port_types/sheet_state.h"
@@ -60,20 +62,24 @@ class CameraDepthSimPlugin final : public CameraPlugin {
     sm.hand_height_mm = p.get_in_range<double>("hand_height_mm", sm.hand_height_mm, 0.0, 1e3);
     const double period_s = p.get_in_range<double>("frame_period_s", 1.0 / 30, 1e-3, 10.0);
     truth_.bind(ports);
+    shapes_.bind(p, ports);
     auto src = std::make_unique<DepthSimSource>(std::move(cams), front, back, ppm, truth_.mesh_source(), ro, sm, colour,
                                                 static_cast<std::int64_t>(period_s * 1e9),
                                                 crease::rt::now_ns());
+    src->set_shapes_source(shapes_.shapes_source());
     configure_camera(p, ports, std::move(src), true, kDepthImagesPort, kDepthFramesPort);
   }
 
   crease::Status update(const crease::Cycle& cycle) override {
     // Hand the newest truth to the renderer before asking for the next frame.
     truth_.forward_rt(cycle.time_ns);
+    shapes_.forward_rt(cycle.time_ns);
     return CameraPlugin::update(cycle);
   }
 
  private:
   SimTruthFeed truth_;
+  SimShapesFeed shapes_;
 };
 
 }  // namespace

@@ -5,8 +5,12 @@
 // Parameters: cameras: DIR (cam0.yaml..), layout: layout.yaml, seed, noise, blur_px, occluders,
 // frame_period_s (the stamp of frames rendered before the first truth); dropouts, dropout_frames,
 // dropout_from_frame, dropout_to_frame, dropout_seed (cameras that deliver nothing for a run of
-// frame sets: sim_source.h); and camera_plugin.h's.
-// Inputs: sheet_truth (crease::SheetState). Outputs: images (frames), frames (CameraFrames).
+// frame sets: sim_source.h); world_shapes (bool, default false: draw the world's arms and hands
+// of the `world_shapes` port, their real geometry, as skin-coloured occluders depth-tested
+// against the sheet; `occluders` are random hand-like ones, for the tracking benchmarks); and
+// camera_plugin.h's.
+// Inputs: sheet_truth (crease::SheetState), world_shapes (crease::WorldShapes, with
+// `world_shapes: true`). Outputs: images (frames), frames (CameraFrames).
 #include <memory>
 
 #include "core/port_types/sheet_state.h"
@@ -40,19 +44,23 @@ class CameraSimPlugin final : public CameraPlugin {
         p.get_in_range<long long>("dropout_seed", static_cast<long long>(ro.seed), 0, (1LL << 62)));
     auto drops = draw_dropouts(dropout_seed, dropouts, dropout_frames, from, to, static_cast<int>(cams.size()));
     truth_.bind(ports);
+    shapes_.bind(p, ports);
     auto src = std::make_unique<SimSource>(renderer, truth_.mesh_source(), ro, static_cast<std::int64_t>(period_s * 1e9),
                                            crease::rt::now_ns(), std::move(drops));
+    src->set_shapes_source(shapes_.shapes_source());
     configure_camera(p, ports, std::move(src));
   }
 
   crease::Status update(const crease::Cycle& cycle) override {
     // Hand the newest truth to the renderer before asking for the next frame.
     truth_.forward_rt(cycle.time_ns);
+    shapes_.forward_rt(cycle.time_ns);
     return CameraPlugin::update(cycle);
   }
 
  private:
   SimTruthFeed truth_;
+  SimShapesFeed shapes_;
 };
 
 }  // namespace

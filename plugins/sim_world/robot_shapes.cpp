@@ -1,5 +1,6 @@
 #include "plugins/sim_world/robot_shapes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -146,6 +147,40 @@ void advance_shape_poses_rt(std::vector<WorldShape>& shapes, const std::array<co
     }
     s.pose1 = p;
     to_quat(p, s.quat1);
+  }
+}
+
+// The port's enums are the world's, value for value.
+static_assert(int(WorldShapes::Kind::sphere) == int(GeomKind::sphere) &&
+              int(WorldShapes::Kind::capsule) == int(GeomKind::capsule) &&
+              int(WorldShapes::Kind::cylinder) == int(GeomKind::cylinder) &&
+              int(WorldShapes::Kind::box) == int(GeomKind::box));
+static_assert(int(WorldShapes::Role::pad) == int(ShapeRole::pad) &&
+              int(WorldShapes::Role::back) == int(ShapeRole::back) &&
+              int(WorldShapes::Role::fingertip) == int(ShapeRole::fingertip) &&
+              int(WorldShapes::Role::finger) == int(ShapeRole::finger) &&
+              int(WorldShapes::Role::palm) == int(ShapeRole::palm) &&
+              int(WorldShapes::Role::hand) == int(ShapeRole::hand) &&
+              int(WorldShapes::Role::arm) == int(ShapeRole::arm));
+
+void export_shapes_rt(const std::vector<WorldShape>& shapes, WorldShapes& out) noexcept {
+  const std::size_t n = std::min<std::size_t>(shapes.size(), WorldShapes::kCapacity);
+  out.count = static_cast<std::uint32_t>(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const WorldShape& s = shapes[i];
+    WorldShapes::Shape& o = out.shapes[i];
+    o.kind = static_cast<WorldShapes::Kind>(s.geom.kind);
+    o.role = static_cast<WorldShapes::Role>(s.role);
+    o.side = static_cast<std::uint8_t>(s.side);
+    o.radius_mm = static_cast<float>(s.geom.radius_mm);
+    o.half_length_mm = static_cast<float>(s.geom.half_length_mm);
+    o.half_mm[0] = static_cast<float>(s.geom.half_mm.x);
+    o.half_mm[1] = static_cast<float>(s.geom.half_mm.y);
+    o.half_mm[2] = static_cast<float>(s.geom.half_mm.z);
+    o.position_mm[0] = static_cast<float>(s.pose1.t.x);
+    o.position_mm[1] = static_cast<float>(s.pose1.t.y);
+    o.position_mm[2] = static_cast<float>(s.pose1.t.z);
+    for (int k = 0; k < 9; ++k) o.rotation[k] = static_cast<float>(s.pose1.r[k]);
   }
 }
 

@@ -10,6 +10,7 @@
 #include <array>
 #include <vector>
 
+#include "core/port_types/world_shapes.h"
 #include "plugins/robot_model/robot_model.h"
 #include "plugins/sim_world/randomise.h"
 #include "plugins/sim_world/shape_geometry.h"
@@ -57,5 +58,9 @@ struct WorldShape {
 // first: both poses from KIN (no motion).
 void advance_shape_poses_rt(std::vector<WorldShape>& shapes, const std::array<const SideKinematics*, robot::kSides>& kin,
                             bool first) noexcept;
+
+// RT: every shape (up to WorldShapes::kCapacity) at its pose at the step's end (pose1) into OUT,
+// with its kind, dimensions, role and side; OUT's stamp and step are the caller's.
+void export_shapes_rt(const std::vector<WorldShape>& shapes, WorldShapes& out) noexcept;
 
 }  // namespace crease::world

@@ -7,6 +7,8 @@
 // the control loop (a step costs about a fifth of a period).
 //   output world_state  (latest WorldState: fingertips, contact forces, joint angles, counters)
 //   output sheet_truth  (latest SheetState: the world's sheet, every truth_every_steps steps)
+//   output world_shapes (latest WorldShapes: the arms' and hands' shapes, every shapes_every_steps
+//                        steps, for the simulated cameras to draw)
 // The fingertips' forces reach the drivers as tactile readings (world_tactile.h): the right
 // hand's taxel matrix on a socket link (hand_driver `tactile_device: tactile_r`), the left hand's
 // PST sensors in its pressure frames.
@@ -21,6 +23,7 @@
 
 #include "core/plugin.h"
 #include "core/port_types/sheet_state.h"
+#include "core/port_types/world_shapes.h"
 #include "core/port_types/world_state.h"
 #include "drivers/host/bus_prefix.h"
 #include "plugins/robot_model/robot_model.h"
@@ -77,6 +80,9 @@ class SimWorldPlugin final : public Plugin {
     world_out_ = ports.latest_output<WorldState>("world_state", WorldState{});
     const auto no_sheet = std::make_unique<SheetState>();  // the safe value: no sheet (0 x 0 nodes)
     sheet_out_ = ports.latest_output<SheetState>("sheet_truth", *no_sheet);
+    shapes_ = std::make_unique<WorldShapes>();
+    const auto no_shapes = std::make_unique<WorldShapes>();  // the safe value: no robot in view
+    shapes_out_ = ports.latest_output<WorldShapes>("world_shapes", *no_shapes);
     log_lines(wd::describe(cfg_.world.seed, world_->draws()));
   }
 
@@ -89,6 +95,8 @@ class SimWorldPlugin final : public Plugin {
     *state_ = world_->state();
     state_->timestamp_ns = cycle.time_ns;  // the port's stamp: the loop's clock
     world_out_.write(*state_, cycle.time_ns);
+    if (steps_ % static_cast<std::uint64_t>(cfg_.shapes_every_steps) == 0)
+      publish_shapes(cycle.time_ns);
     if (steps_++ % static_cast<std::uint64_t>(cfg_.truth_every_steps) == 0) publish_sheet(cycle.time_ns);
     return Status::ok;
   }
@@ -102,6 +110,13 @@ class SimWorldPlugin final : public Plugin {
   }
 
  private:
+  void publish_shapes(std::int64_t now_ns) noexcept {
+    wd::export_shapes_rt(world_->shapes(), *shapes_);
+    shapes_->timestamp_ns = now_ns;
+    shapes_->step = world_->state().step;
+    shapes_out_.write(*shapes_, now_ns);
+  }
+
   void publish_sheet(std::int64_t now_ns) noexcept {
     world_->export_sheet_rt(*full_);
     full_->timestamp_ns = now_ns;
@@ -157,8 +172,10 @@ class SimWorldPlugin final : public Plugin {
   std::unique_ptr<wd::BusFaultInjector> faults_;  // faults: true
   std::unique_ptr<SheetState> full_, truth_;
   std::unique_ptr<WorldState> state_;
+  std::unique_ptr<WorldShapes> shapes_;
   LatestOutput<WorldState> world_out_;
   LatestOutput<SheetState> sheet_out_;
+  LatestOutput<WorldShapes> shapes_out_;
   std::uint64_t steps_ = 0;
 };
 

@@ -90,6 +90,7 @@ WorldPluginConfig read_world_config(const Params& p) {
 
   c.truth_every_steps = p.get_in_range<int>("truth_every_steps", c.truth_every_steps, 1, 1000);
   c.truth_stride = p.get_in_range<int>("truth_stride", c.truth_stride, 1, 8);
+  c.shapes_every_steps = p.get_in_range<int>("shapes_every_steps", c.truth_every_steps, 1, 1000);
   if ((g.nodes_u - 1) % c.truth_stride != 0 || (g.nodes_v - 1) % c.truth_stride != 0) {
     p.fail("truth_stride", "must divide the grid's intervals (nodes_u - 1 = " + std::to_string(g.nodes_u - 1) +
                                ", nodes_v - 1 = " + std::to_string(g.nodes_v - 1) + ")");

@@ -20,6 +20,9 @@ struct WorldPluginConfig {
   // world sheet as the tracking model's 15 x 21, which sheet_score compares node by node).
   int truth_every_steps = 16;
   int truth_stride = 1;
+  // `world_shapes` (the robot's shapes, for the simulated cameras) every shapes_every_steps world
+  // steps, in the same steps as the truth when the two rates are equal; default: the truth's.
+  int shapes_every_steps = 16;
   std::string bus_prefix;  // resolved (`auto`: this creased's own, drivers/host/bus_prefix.h)
   std::uint32_t bitrate = 1'000'000, data_bitrate = 5'000'000;
   // `tactile_link`: the taxel matrix's serial link, a Unix socket at simulated_link_path(bus_prefix,

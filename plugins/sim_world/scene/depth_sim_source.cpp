@@ -18,6 +18,7 @@ DepthSimSource::DepthSimSource(std::vector<DepthCamera> cameras, const cv::Mat& 
       colour_(colour),
       period_ns_(period_ns),
       start_ns_(start_ns) {
+  render_.table_z_mm = sensor_.table_z_mm;  // the depth's table hides the shapes below it too
   for (const Camera& c : cams_) rays_.push_back(ray_table(c));
 }
 
@@ -28,6 +29,7 @@ cv::Mat DepthSimSource::plain_texture(double w_mm, double h_mm, double ppm) {
 
 bool DepthSimSource::grab(Frame& frame) {
   const SheetMesh mesh = mesh_at_(next_);
+  if (shapes_now_) shapes_now_(shapes_);
   RenderOptions o = render_;
   o.seed = render_.seed + next_;
   frame.index = next_;
@@ -35,7 +37,7 @@ bool DepthSimSource::grab(Frame& frame) {
                                               : start_ns_ + static_cast<std::int64_t>(next_) * period_ns_;
   frame.images.resize(2 * cams_.size());
   for (std::size_t k = 0; k < cams_.size(); ++k) {
-    renderer_.render(static_cast<int>(k), mesh, o, view_);
+    renderer_.render(static_cast<int>(k), mesh, o, view_, shapes_);
     cv::Mat& depth = frame.images[2 * k];
     cv::Mat& bgr = frame.images[2 * k + 1];
     if (!frame.fill_in_place) {  // fresh buffers: the caller keeps the last ones

@@ -32,6 +32,11 @@ class DepthSimSource final : public CameraSource {
     return depth_channel_specs(cams_);
   }
   bool grab(Frame& frame) override;  // never ends
+  // Before the first grab: `shapes_now(out)` fills OUT with the world's shapes to draw in the
+  // next frame (empty: none), at their real depth (depth_view.h).
+  void set_shapes_source(std::function<void(std::vector<SceneShape>&)> shapes_now) {
+    shapes_now_ = std::move(shapes_now);
+  }
 
   // A plain sheet's texture (uniform white) for the constructor's front and back.
   [[nodiscard]] static cv::Mat plain_texture(double w_mm, double h_mm, double px_per_mm);
@@ -49,6 +54,8 @@ class DepthSimSource final : public CameraSource {
   std::int64_t start_ns_;
   std::uint64_t next_ = 0;
   RenderedView view_;
+  std::function<void(std::vector<SceneShape>&)> shapes_now_;
+  std::vector<SceneShape> shapes_;
 };
 
 }  // namespace crease::vision

@@ -27,7 +27,8 @@ void make_depth_view(const Camera& cam, const cv::Mat& rays, double unit_mm, con
   depth.create(H, W, CV_16UC1);
   bgr.create(H, W, CV_8UC3);
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  // True camera-frame z of what each pixel sees: the sheet, else the table, raised by a hand.
+  // True camera-frame z of what each pixel sees: a world shape, else the sheet, else the table
+  // (raised by a random occluder).
   cv::Mat z(H, W, CV_32F);
   const cv::Vec3d c = cam.centre_world();
   const cv::Matx33d rt = cam.R.t();
@@ -35,6 +36,7 @@ void make_depth_view(const Camera& cam, const cv::Mat& rays, double unit_mm, con
     const auto* ray = rays.ptr<cv::Vec2f>(y);
     const float* zs = view.depth.ptr<float>(y);
     const std::uint8_t* occ = view.occluder_mask.empty() ? nullptr : view.occluder_mask.ptr<std::uint8_t>(y);
+    const float* zh = view.shape_depth.empty() ? nullptr : view.shape_depth.ptr<float>(y);
     const std::uint8_t* grey = view.image.ptr<std::uint8_t>(y);
     float* zr = z.ptr<float>(y);
     auto* col = bgr.ptr<cv::Vec3b>(y);
@@ -44,10 +46,12 @@ void make_depth_view(const Camera& cam, const cv::Mat& rays, double unit_mm, con
       const double s_table = std::abs(d[2]) > 1e-12 ? (sm.table_z_mm - c[2]) / d[2] : -1.0;
       const bool sheet = std::isfinite(zs[x]) && (s_table <= 0 || zs[x] <= s_table);
       double zz = sheet ? zs[x] : (s_table > 0 ? s_table : kInf);
-      const bool hand = occ != nullptr && occ[x] != 0;
+      const bool shape =
+          zh != nullptr && std::isfinite(zh[x]);  // the world's arms and hands: exact
+      const bool hand = shape || (occ != nullptr && occ[x] != 0);
       const double g = grey[x];
       if (hand) {
-        zz -= sm.hand_height_mm;
+        zz = shape ? zh[x] : zz - sm.hand_height_mm;
         const double shade = std::min(1.0, g / 170.0);
         col[x] = cv::Vec3b(cv::saturate_cast<std::uint8_t>(cm.hand_bgr[0] * shade),
                            cv::saturate_cast<std::uint8_t>(cm.hand_bgr[1] * shade),

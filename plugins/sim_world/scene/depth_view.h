@@ -4,16 +4,19 @@
 //  - noise: Gaussian, RMS sigma(z) = z^2 * subpixel / (f_px * baseline_mm), Intel's formula for
 //    the D400 series' depth RMS error (Grunnet-Jepsen et al., "Tuning depth cameras for best
 //    performance", Intel whitepaper, rev. 2.x); D435: baseline 50 mm, subpixel 0.08 (Intel's
-//    typical figure); at 848x480 f ~ 428 px, so sigma = 0.93 mm at 0.5 m, 1.6 mm at 0.65 m, 2.4 mm at 0.8 m;
+//    typical figure); at 848x480 f ~ 428 px, so sigma = 0.93 mm at 0.5 m, 1.6 mm at 0.65 m, 2.4 mm
+//    at 0.8 m;
 //  - no depth (0) where the ray meets the surface at more than max_incidence_deg from its normal
 //    (grazing: no texture match) and at depth edges (a neighbour more than edge_jump_mm away:
 //    the stereo matcher's invalidated band around occluding edges);
 //  - quantisation to the device's depth unit (depth_unit_mm of the calibration), 0 = no depth,
 //    out of [min_range_mm, max_range_mm] = no depth;
-//  - hand-like occluders (the renderer's occluder mask) hand_height_mm above what they cover.
+//  - the world's arms and hands (the renderer's shape depth: their real geometry) at their own
+//    depth; random hand-like occluders (the rest of the renderer's occluder mask)
+//    hand_height_mm above what they cover.
 // Colour: the plain sheet (seed 001's origami paper) is sheet_bgr shaded as the grey render is;
-// the marker sheet keeps its grey print; table grey; hands skin-coloured. Deterministic for a
-// seed. Not RT code (a worker thread's).
+// the marker sheet keeps its grey print; table grey; hands (and arms) skin-coloured.
+// Deterministic for a seed. Not RT code (a worker thread's).
 #pragma once
 
 #include <cstdint>
@@ -34,7 +37,7 @@ struct DepthSensorModel {
   double min_range_mm = 200.0;     // D435 minimum depth at 848x480 ~ 195 mm
   double max_range_mm = 3000.0;
   double table_z_mm = 0.0;         // the table plane, world z (seen where no sheet is)
-  double hand_height_mm = 40.0;    // occluders' height above what they cover
+  double hand_height_mm = 40.0;    // random occluders' height above what they cover
 };
 
 struct DepthColourModel {

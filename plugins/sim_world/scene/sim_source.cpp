@@ -33,6 +33,7 @@ SimSource::SimSource(std::shared_ptr<const ViewRenderer> renderer,
 
 bool SimSource::grab(Frame& frame) {
   const SheetMesh mesh = mesh_at_(next_);
+  if (shapes_now_) shapes_now_(shapes_);
   RenderOptions o = options_;
   o.seed = options_.seed + next_;
   frame.index = next_;
@@ -51,7 +52,7 @@ bool SimSource::grab(Frame& frame) {
     }
     RenderedView v;  // fresh buffers (frame.images[k] keeps this one), or the caller's
     if (frame.fill_in_place) v.image = frame.images[k];
-    renderer_->render(static_cast<int>(k), mesh, o, v);
+    renderer_->render(static_cast<int>(k), mesh, o, v, shapes_);
     frame.images[k] = v.image;
   }
   ++next_;

@@ -31,7 +31,8 @@ struct CameraDropout {
 // Renders the mesh returned by `mesh_at(frame index)` for every camera; frame i is stamped with
 // the mesh's own time when it has one (SheetMesh::timestamp_ns >= 0, e.g. the simulated world's
 // truth), else start_ns + i * period_ns (pass the CLOCK_MONOTONIC start time in a running
-// system). Frame i's noise seed is options.seed + i.
+// system). Frame i's noise seed is options.seed + i. With a shapes source (set_shapes_source)
+// every frame also draws the world's arms and hands it gives at that frame.
 class SimSource final : public CameraSource {
  public:
   SimSource(std::shared_ptr<const ViewRenderer> renderer,
@@ -39,6 +40,11 @@ class SimSource final : public CameraSource {
             std::int64_t period_ns, std::int64_t start_ns = 0, std::vector<CameraDropout> dropouts = {});
   [[nodiscard]] const std::vector<Camera>& cameras() const override { return renderer_->cameras(); }
   bool grab(Frame& frame) override;  // never ends
+  // Before the first grab: `shapes_now(out)` fills OUT with the shapes to draw in the next frame
+  // (empty: none).
+  void set_shapes_source(std::function<void(std::vector<SceneShape>&)> shapes_now) {
+    shapes_now_ = std::move(shapes_now);
+  }
 
  private:
   std::shared_ptr<const ViewRenderer> renderer_;
@@ -48,6 +54,8 @@ class SimSource final : public CameraSource {
   std::int64_t start_ns_;
   std::uint64_t next_ = 0;
   std::vector<CameraDropout> dropouts_;
+  std::function<void(std::vector<SceneShape>&)> shapes_now_;
+  std::vector<SceneShape> shapes_;
 };
 
 }  // namespace crease::vision

@@ -106,11 +106,12 @@ ViewRenderer::ViewRenderer(const cv::Mat& front, const cv::Mat& back, double ppm
       }
     }
     rays_.push_back(rays);
+    ray_bounds_.push_back(ray_bounds(rays));
   }
 }
 
 void ViewRenderer::render(int ci, const SheetMesh& mesh, const RenderOptions& opt,
-                          RenderedView& out) const {
+                          RenderedView& out, std::span<const SceneShape> shapes) const {
   const Camera& cam = cameras_.at(static_cast<std::size_t>(ci));
   const cv::Mat& rays = rays_[static_cast<std::size_t>(ci)];
   cv::RNG rng(opt.seed * 1000003ULL + static_cast<std::uint64_t>(ci) * 7919ULL + 17ULL);
@@ -179,6 +180,14 @@ void ViewRenderer::render(int ci, const SheetMesh& mesh, const RenderOptions& op
     }
 
   out.occluder_mask = cv::Mat::zeros(cam.height, cam.width, CV_8U);
+  out.shape_depth.create(cam.height, cam.width, CV_32F);
+  out.shape_depth.setTo(cv::Scalar(kInf));
+  if (!shapes.empty()) {
+    ShapeDrawing drawing;
+    drawing.table_z_mm = opt.table_z_mm;
+    draw_shapes(cam, rays, ray_bounds_[static_cast<std::size_t>(ci)], shapes, drawing, out.depth,
+                img, out.shape_depth, out.occluder_mask);
+  }
   if (any && opt.occluders > 0) {
     const cv::Rect region = cv::Rect(sheet_box) & cv::Rect(0, 0, cam.width, cam.height);
     for (int k = 0; k < opt.occluders; ++k) draw_hand(img, out.occluder_mask, rng, region);

@@ -1,10 +1,14 @@
 // camera_sim renders the sheet of its `sheet_truth` port and nothing of its own: with no
 // writer on the port its cameras see the empty table (vision finds no key-point), and the
-// key-points follow the truth wherever the sheet_truth plugin puts the sheet. The analytic fold
+// key-points follow the truth wherever the sheet_truth plugin puts the sheet. With
+// `world_shapes: true` it draws the world's shapes of that port: a fingertip laid over a marker
+// takes the marker from vision, and it is back once the fingertip is gone; its update allocates
+// nothing. The analytic fold
 // it once kept (fold_start_s, fold_duration_s, fold_angle_deg, truth) is gone: a configuration
 // that still names it is refused with the file, line and key.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -15,6 +19,7 @@
 #include "core/plugin_host.h"
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/keypoints.h"
+#include "core/port_types/world_shapes.h"
 #include "support/host_poll.h"
 
 using namespace std::chrono_literals;
@@ -101,6 +106,69 @@ TEST_CASE("camera_sim renders the sheet_truth plugin's sheet where that plugin p
   CAPTURE(x[1]);
   CHECK(std::abs(x[0]) < 10.0);  // the layout's markers are about centred on the sheet
   CHECK(x[1] - x[0] == doctest::Approx(20.0).epsilon(0.05));
+}
+
+TEST_CASE(
+    "camera_sim with world_shapes: a fingertip over a marker hides it from vision; gone, the "
+    "marker is back") {
+  Fixture fx;
+  fx.add("truth", "sheet_truth", 1, "{start_s: 1000}");  // flat, centred on the table
+  fx.add("cameras", "camera_sim", 5,
+         "{cameras: cameras, layout: markers/layout.yaml, world_shapes: true}");
+  fx.add("vision", "vision", 10, "{cameras: cameras, layout: markers/layout.yaml}");
+  crease::rt::LatestChannel* shapes_w = fx.host.ports().bind_latest_writer(
+      "world_shapes", crease::port_type_of<crease::WorldShapes>(), "test");
+  REQUIRE(shapes_w != nullptr);
+  fx.host.start();
+  REQUIRE(fx.wait_for([&] { return fx.read().frame >= 2 && fx.read().count > 100; }));
+  // The marker whose centre is nearest the table's origin.
+  int id = -1;
+  float at[3] = {};
+  double best = 1e9;
+  for (std::uint32_t i = 0; i < fx.kp->count; ++i) {
+    const crease::Keypoint& k = fx.kp->points[i];
+    const double d = std::hypot(k.world_mm[0], k.world_mm[1]);
+    if (k.corner == 0 && d < best) {
+      best = d;
+      id = k.marker_id;
+      std::copy(k.world_mm, k.world_mm + 3, at);
+    }
+  }
+  REQUIRE(id >= 0);
+  CAPTURE(id);
+  const auto seen = [&](int marker) {
+    for (std::uint32_t i = 0; i < fx.kp->count; ++i)
+      if (fx.kp->points[i].marker_id == marker) return true;
+    return false;
+  };
+  // A distal phalanx (capsule r 9 mm, 38 mm long, along x) 3 mm over that marker.
+  auto shapes = std::make_unique<crease::WorldShapes>();
+  shapes->count = 1;
+  crease::WorldShapes::Shape& tip = shapes->shapes[0];
+  tip.kind = crease::WorldShapes::Kind::capsule;
+  tip.role = crease::WorldShapes::Role::fingertip;
+  tip.radius_mm = 9;
+  tip.half_length_mm = 10;
+  const float along_x[9] = {0, 0, 1, 0, 1, 0, -1, 0, 0};
+  std::copy(along_x, along_x + 9, tip.rotation);
+  tip.position_mm[0] = at[0];
+  tip.position_mm[1] = at[1];
+  tip.position_mm[2] = at[2] + 12;
+  shapes_w->write(shapes.get(), 1);
+  std::uint64_t from = fx.read().frame;
+  CHECK(fx.wait_for([&] { return fx.read().frame > from + 1 && !seen(id) && fx.kp->count > 100; }));
+  // The fingertip gone (no shape): the marker is seen again.
+  shapes->count = 0;
+  shapes_w->write(shapes.get(), 2);
+  from = fx.read().frame;
+  CHECK(fx.wait_for([&] { return fx.read().frame > from + 1 && seen(id); }));
+  for (const auto& i : fx.host.instances()) {  // none faulted; none allocated in a cycle
+    CAPTURE(i.name);
+    CHECK(i.state == crease::RunState::active);
+    CHECK(i.stats->updates.load() > 0);
+    CHECK(i.stats->rt_allocations.load() == 0);
+  }
+  fx.host.stop();
 }
 
 TEST_CASE("camera_sim refuses its removed fold parameters with the file, line and key") {

@@ -1,16 +1,18 @@
 // The sim_world plugin in a PluginHost loop whose cycles the test runs itself (no thread, no
-// wall clock): configure errors name file, line and key; world_state and sheet_truth are
-// published (the truth at the world's grid or every other node of it); a cycle allocates
-// nothing.
+// wall clock): configure errors name file, line and key; world_state, sheet_truth and
+// world_shapes are published (the truth at the world's grid or every other node of it, the
+// shapes at the truth's rate or their own); a cycle allocates nothing.
 #include <doctest/doctest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
 
 #include "core/plugin_host.h"
 #include "core/port_types/sheet_state.h"
+#include "core/port_types/world_shapes.h"
 #include "core/port_types/world_state.h"
 #include "rt/alloc_guard.h"
 
@@ -141,5 +143,60 @@ TEST_CASE("sim_world: world_state every step, sheet_truth at its rate and grid; 
     }
     CHECK(rt::rt_allocation_count() == before);
     CHECK(rig.read<WorldState>("world_state")->step == 45);
+    CHECK(rig.read<WorldShapes>("world_shapes")->step == 33);  // every 16th step from the first
+  }
+}
+
+TEST_CASE("sim_world: world_shapes, every shape of the robot at the truth's rate or its own") {
+  SUBCASE("at the truth's rate, with the truth") {
+    WorldRig rig("{robot: " + kRobot + ", bus_prefix: " + unique_prefix("shapes") +
+                 ", truth_every_steps: 4}");
+    rig.cycles(1);
+    auto sh = rig.read<WorldShapes>("world_shapes");
+    CHECK(sh->step == 1);
+    CHECK(sh->timestamp_ns == 1'000'000'000);
+    rig.cycles(6);  // steps 2..7: the shapes of step 5, as the truth
+    sh = rig.read<WorldShapes>("world_shapes");
+    CHECK(sh->step == 5);
+    CHECK(rig.read<SheetState>("sheet_truth")->step == 5);
+    // Both arms and hands: 88 shapes of the shipped robot, each finite, of its size.
+    CHECK(sh->count == 88);
+    CHECK(sh->all_finite());
+    int pads[2] = {}, arms = 0;
+    for (std::uint32_t i = 0; i < sh->count; ++i) {
+      const WorldShapes::Shape& s = sh->shapes[i];
+      if (s.role == WorldShapes::Role::pad) ++pads[s.side];
+      if (s.role == WorldShapes::Role::arm) ++arms;
+      const float size = s.kind == WorldShapes::Kind::box
+                             ? s.half_mm[0] + s.half_mm[1] + s.half_mm[2]
+                             : s.radius_mm;
+      CHECK(size > 0.5f);
+      CHECK(size < 300.0f);
+    }
+    CHECK(pads[0] == 5);
+    CHECK(pads[1] == 5);
+    CHECK(arms > 0);
+    // Each hand's index pad shape within a few mm of the pad frame world_state reports.
+    auto w = rig.read<WorldState>("world_state");
+    for (int side = 0; side < 2; ++side) {
+      double nearest = 1e9;
+      for (std::uint32_t i = 0; i < sh->count; ++i) {
+        const WorldShapes::Shape& s = sh->shapes[i];
+        if (s.role != WorldShapes::Role::pad || s.side != side) continue;
+        const float* t = w->hand[side].tip[0].position_mm;
+        nearest = std::min<double>(
+            nearest,
+            std::hypot(s.position_mm[0] - t[0], s.position_mm[1] - t[1], s.position_mm[2] - t[2]));
+      }
+      CAPTURE(side);
+      CHECK(nearest < 10.0);
+    }
+  }
+  SUBCASE("at its own rate") {
+    WorldRig rig("{robot: " + kRobot + ", bus_prefix: " + unique_prefix("shapes3") +
+                 ", shapes_every_steps: 3}");
+    rig.cycles(8);  // steps 1..8: shapes of steps 1, 4, 7
+    CHECK(rig.read<WorldShapes>("world_shapes")->step == 7);
+    CHECK(rig.read<SheetState>("sheet_truth")->step == 1);
   }
 }

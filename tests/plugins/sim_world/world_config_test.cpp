@@ -1,6 +1,6 @@
-// sim_world's table and sheet parameters: the table's extent (an edge to overhang) read as given, null
-// sides without an edge, the sheet's turn; every malformed value a ConfigError naming file, line
-// and key.
+// sim_world's table and sheet parameters: the table's extent (an edge to overhang) read as given,
+// null sides without an edge, the sheet's turn; every malformed value a ConfigError naming file,
+// line and key; the world_shapes rate (the truth's by default).
 #include "plugins/sim_world/world_config.h"
 
 #include <doctest/doctest.h>
@@ -76,4 +76,13 @@ TEST_CASE("faults: off unless asked; drawn from the world's seed unless fault_se
     CHECK(e.find("sim.yaml:") != std::string::npos);
     CHECK(e.find("fault") != std::string::npos);
   }
+}
+
+TEST_CASE(
+    "shapes_every_steps: the truth's rate unless given; out of range an error naming the key") {
+  CHECK(read("").shapes_every_steps == 16);
+  CHECK(read("truth_every_steps: 4\n").shapes_every_steps == 4);
+  CHECK(read("truth_every_steps: 4\nshapes_every_steps: 33\n").shapes_every_steps == 33);
+  CHECK(error_of("shapes_every_steps: 0\n").find("world.params.shapes_every_steps") !=
+        std::string::npos);
 }

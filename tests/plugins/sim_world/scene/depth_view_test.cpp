@@ -2,12 +2,14 @@
 // the shipped D435 calibrations (config/depth_cameras): a flat plain sheet back-projects to its
 // plane within the noise model's figure; the colour mask keeps >= 99 % of the sheet's pixels
 // with depth and no pixel of a hand; no depth at grazing angles (and depth there once the
-// grazing limit is lifted); the depth image is in the calibration's unit.
+// grazing limit is lifted); the depth image is in the calibration's unit; the world's shapes at
+// their own depth over the sheet and hidden under it.
 #include "plugins/sim_world/scene/depth_sim_source.h"
 
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "plugins/depth_tracking/point_cloud.h"
 
@@ -29,13 +31,14 @@ struct Shot {
   RenderedView view;
 };
 
-Shot shoot(const DepthCamera& cam, const SheetMesh& mesh, int occluders, DepthSensorModel sm = {}) {
+Shot shoot(const DepthCamera& cam, const SheetMesh& mesh, int occluders, DepthSensorModel sm = {},
+           const std::vector<SceneShape>& shapes = {}) {
   const cv::Mat tex = DepthSimSource::plain_texture(400, 400, 1.0);
   ViewRenderer r(tex, tex, 1.0, {cam.camera});
   Shot s;
   RenderOptions ro;
   ro.occluders = occluders;
-  r.render(0, mesh, ro, s.view);
+  r.render(0, mesh, ro, s.view, shapes);
   make_depth_view(cam.camera, ray_table(cam.camera), cam.depth_unit_mm, s.view, sm, DepthColourModel{}, 7,
                   s.depth, s.bgr);
   return s;
@@ -113,6 +116,47 @@ TEST_CASE("the colour mask keeps >= 99 % of the sheet's pixels with depth and no
     CHECK(sheet_kept >= 0.99 * sheet_px);
     CHECK(hand_kept == 0);
   }
+}
+
+TEST_CASE(
+    "the world's shapes at their own depth: a fingertip over the sheet, the sheet beside it; none "
+    "under it") {
+  const auto cams = load_depth_camera_dir(kSrc + "/config/depth_cameras");
+  const Camera& cam = cams[0].camera;  // overhead
+  DepthSensorModel sm;
+  sm.noise = false;  // exact depth, quantised to the 1 mm unit
+  // A fingertip (sphere r 8 mm) 40 mm over the sheet lying on the table, and the sheet 50 mm beside
+  // it.
+  const SheetMesh flat = flat_sheet(15, 21, 210, 297, {0, 0, kSheetZ});
+  SceneShape tip;
+  tip.geom.kind = crease::world::GeomKind::sphere;
+  tip.geom.radius_mm = 8;
+  tip.pose.t = {0, 0, 40};
+  const Shot s = shoot(cams[0], flat, 0, sm, {tip});
+  const auto pixel = [&](cv::Vec3d w) {
+    cv::Point2d px;
+    REQUIRE(cam.project(w, px));
+    return cv::Point(static_cast<int>(std::lround(px.x)), static_cast<int>(std::lround(px.y)));
+  };
+  // Along the ray to the sphere's point nearest the camera.
+  const cv::Vec3d centre(0, 0, 40), to_cam = cv::normalize(cam.centre_world() - centre);
+  const cv::Vec3d near_point = centre + 8.0 * to_cam;
+  const cv::Point p_tip = pixel(near_point), p_sheet = pixel({50, 0, kSheetZ});
+  const double z_tip = cam.to_camera(near_point)[2], z_sheet = cam.to_camera({50, 0, kSheetZ})[2];
+  CAPTURE(z_tip);
+  CAPTURE(z_sheet);
+  CHECK(std::abs(s.depth.at<std::uint16_t>(p_tip) - z_tip) <= 1.0);
+  CHECK(std::abs(s.depth.at<std::uint16_t>(p_sheet) - z_sheet) <= 1.0);
+  CHECK(z_sheet - z_tip > 30.0);  // the two are told apart
+  // Skin where the fingertip is (red over blue), the blue sheet beside it.
+  const cv::Vec3b c_tip = s.bgr.at<cv::Vec3b>(p_tip), c_sheet = s.bgr.at<cv::Vec3b>(p_sheet);
+  CHECK(c_tip[2] > c_tip[0]);
+  CHECK(c_sheet[0] > c_sheet[2]);
+  // The sheet held 60 mm up, the fingertip under it: the depth image is the sheet's alone.
+  const SheetMesh raised = flat_sheet(15, 21, 210, 297, {0, 0, 60});
+  const Shot plain = shoot(cams[0], raised, 0, sm), under = shoot(cams[0], raised, 0, sm, {tip});
+  CHECK(cv::countNonZero(under.view.occluder_mask) == 0);
+  CHECK(cv::norm(plain.depth, under.depth, cv::NORM_INF) == 0);
 }
 
 TEST_CASE("no depth at grazing angles: a sheet seen edge-on has none until the limit is lifted") {
