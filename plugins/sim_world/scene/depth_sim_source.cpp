@@ -19,6 +19,7 @@ DepthSimSource::DepthSimSource(std::vector<DepthCamera> cameras, const cv::Mat& 
       period_ns_(period_ns),
       start_ns_(start_ns) {
   render_.table_z_mm = sensor_.table_z_mm;  // the depth's table hides the shapes below it too
+  render_.shape_lattice_px = 1;              // the shapes' depth exact: it is what the camera measures
   for (const Camera& c : cams_) rays_.push_back(ray_table(c));
 }
 

@@ -192,6 +192,7 @@ constexpr double kNear = 1.0;  // mm, camera z
 struct InView {
   cv::Rect rect;      // pixels
   double z_near = 0;  // the nearest camera z the shape can have there, mm
+  double z_far = 0;   // the farthest
   std::size_t index = 0;
 };
 
@@ -205,9 +206,10 @@ InView pixel_rect(const Camera& cam, const RayBounds& rb, const SceneShape& sh) 
     v[k] =
         cam.to_camera(centre + cv::Vec3d((k & 1) ? half[0] : -half[0], (k & 2) ? half[1] : -half[1],
                                          (k & 4) ? half[2] : -half[2]));
-  double x0 = kInfD, x1 = -kInfD, y0 = kInfD, y1 = -kInfD, z0 = kInfD;
+  double x0 = kInfD, x1 = -kInfD, y0 = kInfD, y1 = -kInfD, z0 = kInfD, z1 = -kInfD;
   const auto add = [&](const cv::Vec3d& p) {
     z0 = std::min(z0, p[2]);
+    z1 = std::max(z1, p[2]);
     x0 = std::min(x0, p[0] / p[2]);
     x1 = std::max(x1, p[0] / p[2]);
     y0 = std::min(y0, p[1] / p[2]);
@@ -230,7 +232,13 @@ InView pixel_rect(const Camera& cam, const RayBounds& rb, const SceneShape& sh) 
   while (r0 < H && rb.row_hi[r0] < y0) ++r0;
   while (r1 >= r0 && rb.row_lo[r1] > y1) --r1;
   if (c0 > c1 || r0 > r1) return {};
-  return {{c0, r0, c1 - c0 + 1, r1 - r0 + 1}, z0, 0};
+  return {{c0, r0, c1 - c0 + 1, r1 - r0 + 1}, z0, z1, 0};
+}
+
+// The shape's smallest thickness (mm): no section through it is thinner.
+double thickness(const Geom& g) {
+  return g.kind == GeomKind::box ? 2 * std::min({g.half_mm.x, g.half_mm.y, g.half_mm.z})
+                                 : 2 * g.radius_mm;
 }
 
 // The radius of the sphere about the shape's centre that holds it.
@@ -337,18 +345,19 @@ void draw_shapes(const Camera& cam, const cv::Mat& rays, const RayBounds& bounds
       lambert_out = static_cast<float>(std::max(0.0, world_dir(sh.pose, n).dot(light)));
       return true;
     };
-    // Every other pixel of every other row first (a lattice); a pixel between lattice points that
-    // all meet the shape takes their mean (a shape is convex: a ray between four that meet it
-    // meets it; and smooth: the mean is off by a fraction of a millimetre at most, at a grazing
-    // rim), every other pixel is cast.
-    const int gw = (box.width + 1) / 2, gh = (box.height + 1) / 2;
+    // Every kStep-th pixel of every kStep-th row first (a lattice); a pixel inside a lattice cell
+    // whose four corners all meet the shape takes their bilinear interpolation (a shape is convex:
+    // a ray between four that meet it meets it; and smooth: the interpolated depth is off by the
+    // surface's sag over the cell, ShapeDrawing::lattice_px), every other pixel is cast.
+    const int kStep = std::max(1, drawing.lattice_px);
+    const int gw = (box.width - 1) / kStep + 1, gh = (box.height - 1) / kStep + 1;
     lattice.assign(static_cast<std::size_t>(gw) * static_cast<std::size_t>(gh), {kNaN, 0.f});
     for (int j = 0; j < gh; ++j) {
-      const int y = box.y + 2 * j;
+      const int y = box.y + kStep * j;
       const float* sheet = sheet_depth.ptr<float>(y);
       const float* zs = shape_depth.ptr<float>(y);
       for (int i = 0; i < gw; ++i) {
-        const int x = box.x + 2 * i;
+        const int x = box.x + kStep * i;
         if (!(z_near < sheet[x]) || !(z_near < zs[x]))
           continue;  // covered: unknown, its neighbours are cast
         auto& l = lattice[static_cast<std::size_t>(j * gw + i)];
@@ -358,32 +367,48 @@ void draw_shapes(const Camera& cam, const cv::Mat& rays, const RayBounds& bounds
     const auto at = [&](int i, int j) -> const LatticePoint& {
       return lattice[static_cast<std::size_t>(j * gw + i)];
     };
+    // A shape at least 3 cells thick in the image (its thinnest section at its farthest, the focal
+    // length less a tenth for the distortion) holds a lattice point in every part of it: a cell
+    // whose four corners all miss it is missed but for a sliver at the tip of a silhouette (for a
+    // rim of radius R px, less than 2 / R px deep). A thinner one is cast there pixel by pixel.
+    const bool thick = 0.9 * std::min(cam.K(0, 0), cam.K(1, 1)) * thickness(sh.geom) >=
+                       3.0 * kStep * in_view.z_far;
+    // A bounding box wholly above the table's top: no pixel of it is under the table.
+    const bool may_dip = sh.pose.t.z - world::half_extent(sh.geom, sh.pose, 2) < drawing.table_z_mm;
     for (int y = box.y; y < box.y + box.height; ++y) {
       const float* sheet = sheet_depth.ptr<float>(y);
       float* zs = shape_depth.ptr<float>(y);
       float* px = image.ptr<float>(y);
       std::uint8_t* mk = mask.ptr<std::uint8_t>(y);
-      const int oy = y - box.y, j0 = oy / 2, j1 = j0 + (oy & 1);
+      const int oy = y - box.y, j0 = oy / kStep, fy = oy % kStep, j1 = j0 + (fy != 0);
+      const float wy = static_cast<float>(fy) / kStep;
       for (int x = box.x; x < box.x + box.width; ++x) {
         if (!(z_near < sheet[x]) || !(z_near < zs[x])) continue;  // something nearer covers it
-        const int ox = x - box.x, i0 = ox / 2, i1 = i0 + (ox & 1);
+        const int ox = x - box.x, i0 = ox / kStep, fx = ox % kStep, i1 = i0 + (fx != 0);
         float s = kInfF, lambert = 0;
         bool hit = false;
         if (i1 < gw && j1 < gh) {
           const LatticePoint &a = at(i0, j0), &b = at(i1, j0), &c2 = at(i0, j1), &d = at(i1, j1);
-          if (a.s < kInfF && b.s < kInfF && c2.s < kInfF &&
-              d.s < kInfF) {  // NaN (unknown) fails too
-            s = 0.25f * (a.s + b.s + c2.s + d.s);
-            lambert = 0.25f * (a.lambert + b.lambert + c2.lambert + d.lambert);
+          // All four met it (NaN, not cast, fails too).
+          if (a.s < kInfF && b.s < kInfF && c2.s < kInfF && d.s < kInfF) {
+            const float wx = static_cast<float>(fx) / kStep;
+            const float w00 = (1 - wx) * (1 - wy), w10 = wx * (1 - wy), w01 = (1 - wx) * wy,
+                        w11 = wx * wy;
+            s = w00 * a.s + w10 * b.s + w01 * c2.s + w11 * d.s;
+            lambert = w00 * a.lambert + w10 * b.lambert + w01 * c2.lambert + w11 * d.lambert;
             hit = true;
+          } else if (thick && a.s == kInfF && b.s == kInfF && c2.s == kInfF && d.s == kInfF) {
+            continue;  // a cell the shape does not reach into
           }
         }
         if (!hit && !cast(x, y, s, lambert)) continue;
         if (!(s < sheet[x]) || !(s < zs[x])) continue;  // behind the sheet or a nearer shape
-        const cv::Vec2f ray = rays.at<cv::Vec2f>(y, x);
-        const double dz =
-            rt(2, 0) * ray[0] + rt(2, 1) * ray[1] + rt(2, 2);  // the ray's world z per camera z
-        if (c[2] + s * dz < drawing.table_z_mm) continue;      // under the table's top
+        if (may_dip) {
+          const cv::Vec2f ray = rays.at<cv::Vec2f>(y, x);
+          // The hit's world z: the ray's world z per camera z times s.
+          const double dz = rt(2, 0) * ray[0] + rt(2, 1) * ray[1] + rt(2, 2);
+          if (c[2] + s * dz < drawing.table_z_mm) continue;  // under the table's top
+        }
         zs[x] = s;
         px[x] = static_cast<float>(drawing.skin_grey * (0.5 + 0.5 * lambert));
         mk[x] = 255;

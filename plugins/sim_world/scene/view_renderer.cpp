@@ -185,6 +185,7 @@ void ViewRenderer::render(int ci, const SheetMesh& mesh, const RenderOptions& op
   if (!shapes.empty()) {
     ShapeDrawing drawing;
     drawing.table_z_mm = opt.table_z_mm;
+    drawing.lattice_px = opt.shape_lattice_px;
     draw_shapes(cam, rays, ray_bounds_[static_cast<std::size_t>(ci)], shapes, drawing, out.depth,
                 img, out.shape_depth, out.occluder_mask);
   }

@@ -24,6 +24,7 @@ struct RenderOptions {
   double exposure = 1.0;       // gain on scene radiance
   int occluders = 0;           // random hand-like occluders over the sheet (drawn over everything)
   double table_z_mm = 0.0;     // the table's top: the world's shapes below it are hidden
+  int shape_lattice_px = 4;    // the world's shapes cast every this many px (shape_view.h); 1: exact
   bool clutter = false;        // busy background (boxes, lines, code-like grids)
 };
 

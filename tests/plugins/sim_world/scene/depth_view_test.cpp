@@ -38,6 +38,7 @@ Shot shoot(const DepthCamera& cam, const SheetMesh& mesh, int occluders, DepthSe
   Shot s;
   RenderOptions ro;
   ro.occluders = occluders;
+  ro.shape_lattice_px = 1;  // as DepthSimSource renders: the shapes' depth exact
   r.render(0, mesh, ro, s.view, shapes);
   make_depth_view(cam.camera, ray_table(cam.camera), cam.depth_unit_mm, s.view, sm, DepthColourModel{}, 7,
                   s.depth, s.bgr);
