@@ -375,43 +375,51 @@ void draw_shapes(const Camera& cam, const cv::Mat& rays, const RayBounds& bounds
                        3.0 * kStep * in_view.z_far;
     // A bounding box wholly above the table's top: no pixel of it is under the table.
     const bool may_dip = sh.pose.t.z - world::half_extent(sh.geom, sh.pose, 2) < drawing.table_z_mm;
-    for (int y = box.y; y < box.y + box.height; ++y) {
-      const float* sheet = sheet_depth.ptr<float>(y);
-      float* zs = shape_depth.ptr<float>(y);
-      float* px = image.ptr<float>(y);
-      std::uint8_t* mk = mask.ptr<std::uint8_t>(y);
-      const int oy = y - box.y, j0 = oy / kStep, fy = oy % kStep, j1 = j0 + (fy != 0);
-      const float wy = static_cast<float>(fy) / kStep;
-      for (int x = box.x; x < box.x + box.width; ++x) {
-        if (!(z_near < sheet[x]) || !(z_near < zs[x])) continue;  // something nearer covers it
-        const int ox = x - box.x, i0 = ox / kStep, fx = ox % kStep, i1 = i0 + (fx != 0);
-        float s = kInfF, lambert = 0;
-        bool hit = false;
-        if (i1 < gw && j1 < gh) {
-          const LatticePoint &a = at(i0, j0), &b = at(i1, j0), &c2 = at(i0, j1), &d = at(i1, j1);
-          // All four met it (NaN, not cast, fails too).
-          if (a.s < kInfF && b.s < kInfF && c2.s < kInfF && d.s < kInfF) {
-            const float wx = static_cast<float>(fx) / kStep;
-            const float w00 = (1 - wx) * (1 - wy), w10 = wx * (1 - wy), w01 = (1 - wx) * wy,
-                        w11 = wx * wy;
-            s = w00 * a.s + w10 * b.s + w01 * c2.s + w11 * d.s;
-            lambert = w00 * a.lambert + w10 * b.lambert + w01 * c2.lambert + w11 * d.lambert;
-            hit = true;
-          } else if (thick && a.s == kInfF && b.s == kInfF && c2.s == kInfF && d.s == kInfF) {
-            continue;  // a cell the shape does not reach into
+    // Cell by cell: the pixels from lattice point (i, j) up to (not including) (i + 1, j + 1);
+    // a cell on the rectangle's last row or column (no far corners) is cast pixel by pixel.
+    for (int j = 0; j < gh; ++j) {
+      const int cy0 = box.y + kStep * j, cy1 = std::min(cy0 + kStep, box.y + box.height);
+      for (int i = 0; i < gw; ++i) {
+        const int cx0 = box.x + kStep * i, cx1 = std::min(cx0 + kStep, box.x + box.width);
+        const bool inner = i + 1 < gw && j + 1 < gh;
+        const LatticePoint& a = at(i, j);
+        const LatticePoint& b = inner ? at(i + 1, j) : a;
+        const LatticePoint& c2 = inner ? at(i, j + 1) : a;
+        const LatticePoint& d = inner ? at(i + 1, j + 1) : a;
+        // All four met it (NaN, not cast, fails too), or none did.
+        const bool all_hit = inner && a.s < kInfF && b.s < kInfF && c2.s < kInfF && d.s < kInfF;
+        if (inner && thick && a.s == kInfF && b.s == kInfF && c2.s == kInfF && d.s == kInfF)
+          continue;  // a cell the shape does not reach into
+        for (int y = cy0; y < cy1; ++y) {
+          const float* sheet = sheet_depth.ptr<float>(y);
+          float* zs = shape_depth.ptr<float>(y);
+          float* px = image.ptr<float>(y);
+          std::uint8_t* mk = mask.ptr<std::uint8_t>(y);
+          const float wy = static_cast<float>(y - cy0) / kStep;
+          for (int x = cx0; x < cx1; ++x) {
+            if (!(z_near < sheet[x]) || !(z_near < zs[x])) continue;  // something nearer covers it
+            float s = kInfF, lambert = 0;
+            if (all_hit) {
+              const float wx = static_cast<float>(x - cx0) / kStep;
+              const float w00 = (1 - wx) * (1 - wy), w10 = wx * (1 - wy), w01 = (1 - wx) * wy,
+                          w11 = wx * wy;
+              s = w00 * a.s + w10 * b.s + w01 * c2.s + w11 * d.s;
+              lambert = w00 * a.lambert + w10 * b.lambert + w01 * c2.lambert + w11 * d.lambert;
+            } else if (!cast(x, y, s, lambert)) {
+              continue;
+            }
+            if (!(s < sheet[x]) || !(s < zs[x])) continue;  // behind the sheet or a nearer shape
+            if (may_dip) {
+              const cv::Vec2f ray = rays.at<cv::Vec2f>(y, x);
+              // The hit's world z: the ray's world z per camera z times s.
+              const double dz = rt(2, 0) * ray[0] + rt(2, 1) * ray[1] + rt(2, 2);
+              if (c[2] + s * dz < drawing.table_z_mm) continue;  // under the table's top
+            }
+            zs[x] = s;
+            px[x] = static_cast<float>(drawing.skin_grey * (0.5 + 0.5 * lambert));
+            mk[x] = 255;
           }
         }
-        if (!hit && !cast(x, y, s, lambert)) continue;
-        if (!(s < sheet[x]) || !(s < zs[x])) continue;  // behind the sheet or a nearer shape
-        if (may_dip) {
-          const cv::Vec2f ray = rays.at<cv::Vec2f>(y, x);
-          // The hit's world z: the ray's world z per camera z times s.
-          const double dz = rt(2, 0) * ray[0] + rt(2, 1) * ray[1] + rt(2, 2);
-          if (c[2] + s * dz < drawing.table_z_mm) continue;  // under the table's top
-        }
-        zs[x] = s;
-        px[x] = static_cast<float>(drawing.skin_grey * (0.5 + 0.5 * lambert));
-        mk[x] = 255;
       }
     }
   }
