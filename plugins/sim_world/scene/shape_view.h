@@ -1,8 +1,9 @@
 // The world's robot as the simulated cameras see it: the arms' and hands' collision shapes of
 // the `world_shapes` port (core/port_types/world_shapes.h) ray-cast exactly through a camera's
 // distortion (the renderer's per-pixel rays), each within the pixels whose rays can meet its
-// bounding box (the box clipped to the space in front of the camera), depth-tested against the
-// sheet the renderer drew (a finger under the sheet is hidden, one over it hides the sheet) and
+// bounding box (the box clipped to the space in front of the camera), on a lattice of
+// ShapeDrawing::lattice_px (interpolated between lattice points that meet it), depth-tested against
+// the sheet the renderer drew (a finger under the sheet is hidden, one over it hides the sheet) and
 // against the table's top (the table hides what is below it). Shapes as
 // plugins/sim_world/shape_geometry.h (box edges rounded). Not RT code (a camera worker's).
 #pragma once
