@@ -180,9 +180,11 @@ void ViewRenderer::render(int ci, const SheetMesh& mesh, const RenderOptions& op
     }
 
   out.occluder_mask = cv::Mat::zeros(cam.height, cam.width, CV_8U);
-  out.shape_depth.create(cam.height, cam.width, CV_32F);
-  out.shape_depth.setTo(cv::Scalar(kInf));
-  if (!shapes.empty()) {
+  if (shapes.empty()) {
+    out.shape_depth.release();  // none drawn: no image to fill and read (depth_view.h)
+  } else {
+    out.shape_depth.create(cam.height, cam.width, CV_32F);
+    out.shape_depth.setTo(cv::Scalar(kInf));
     ShapeDrawing drawing;
     drawing.table_z_mm = opt.table_z_mm;
     drawing.lattice_px = opt.shape_lattice_px;

@@ -33,7 +33,8 @@ struct RenderedView {
   cv::Mat occluder_mask;   // CV_8UC1, 255 where an occluder (a world shape or a random one) hides
                            // the scene
   cv::Mat depth;  // CV_32FC1, camera-frame z of the sheet (mm), +inf elsewhere (also under a shape)
-  cv::Mat shape_depth;  // CV_32FC1, camera-frame z of the world's shape seen (mm), +inf elsewhere
+  cv::Mat shape_depth;  // CV_32FC1, camera-frame z of the world's shape seen (mm), +inf elsewhere;
+                        // empty when no shapes were given
 };
 
 class ViewRenderer {
