@@ -115,9 +115,10 @@ void judge(TrialResult& r) {
     // The reason with the input it came from when the sequence named one: the why of its first
     // abort transition, "abort: device_fault: contact_r unhealthy".
     std::string reason = r.abort_reason;
+    const std::string prefix = "abort: ";
     for (const TimelineEntry& e : r.timeline)
-      if (e.why.rfind("abort: " + r.abort_reason, 0) == 0 && !r.abort_reason.empty()) {
-        reason = e.why.substr(7);
+      if (!reason.empty() && e.why.rfind(prefix + reason, 0) == 0) {
+        reason = e.why.substr(prefix.size());
         break;
       }
     r.failure = r.end == "not_started"
