@@ -11,6 +11,7 @@
 #include "core/port_types/camera_frames.h"
 #include "core/port_types/world_shapes.h"
 #include "support/host_poll.h"
+#include "support/instance_spec.h"
 
 TEST_CASE(
     "camera_depth_sim with world_shapes: frame sets from both cameras, no allocation in its "
@@ -19,14 +20,7 @@ TEST_CASE(
   host.add_loop({"vision", 30.0, 0, -1});
   const auto add = [&](const std::string& name, const std::string& library, int order,
                        const std::string& yaml) {
-    crease::InstanceSpec s;
-    s.name = name;
-    s.library = library;
-    s.loop = "vision";
-    s.order = order;
-    s.params = crease::Params(
-        YAML::Load(yaml), std::string(CREASE_SOURCE_DIR) + "/config/test.yaml", name + ".params");
-    host.add_instance(s);
+    host.add_instance(crease::testing::instance_spec(name, library, "vision", order, yaml));
   };
   add("truth", "sheet_truth", 1, "{start_s: 1000}");
   add("depth_cams", "camera_depth_sim", 5,

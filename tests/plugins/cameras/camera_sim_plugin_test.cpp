@@ -21,11 +21,11 @@
 #include "core/port_types/keypoints.h"
 #include "core/port_types/world_shapes.h"
 #include "support/host_poll.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 
 namespace {
-const std::string kSrc = CREASE_SOURCE_DIR;
 
 struct Fixture {
   crease::PluginHost host{{CREASE_PLUGIN_DIR}};
@@ -34,13 +34,7 @@ struct Fixture {
   // Relative paths resolve against config/ (the file named here).
   void add(const std::string& name, const std::string& library, int order,
            const std::string& yaml) {
-    crease::InstanceSpec s;
-    s.name = name;
-    s.library = library;
-    s.loop = "vision";
-    s.order = order;
-    s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
-    host.add_instance(s);
+    host.add_instance(crease::testing::instance_spec(name, library, "vision", order, yaml));
   }
   // The shipped rig and layout: camera_sim, then vision on its frame sets.
   void add_cameras_and_vision() {
