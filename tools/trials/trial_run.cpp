@@ -284,8 +284,17 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
       const std::int64_t at = rt::now_ns();
       while (truth->poll().has_data() && truth->value().timestamp_ns < at && since(at) < 2.0)
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      if (truth->poll().has_data())
-        r.score = score_sheet(truth->value(), target, o.bounds, have_reference ? reference.get() : nullptr);
+      if (truth->poll().has_data()) {
+        const SheetState& end = truth->value();
+        r.score = score_sheet(end, target, o.bounds, have_reference ? reference.get() : nullptr);
+        if (static_cast<std::uint32_t>(end.nodes_u) * end.nodes_v <= SheetState::kMaxNodes) {
+          r.sheet_nodes_u = end.nodes_u;
+          r.sheet_nodes_v = end.nodes_v;
+          for (int k = 0; k < end.nodes_u * end.nodes_v; ++k)
+            r.sheet_end_mm.push_back(
+                {end.position_mm[k][0], end.position_mm[k][1], end.position_mm[k][2]});
+        }
+      }
       d.request_stop();
     });
     try {
@@ -340,6 +349,10 @@ nlohmann::json to_json(const TrialResult& r) {
   nlohmann::json series = {{"t_s", nlohmann::json::array()}, {"force_r_n", nlohmann::json::array()},
                            {"force_l_n", nlohmann::json::array()}, {"stretch", nlohmann::json::array()},
                            {"measured_r_n", nlohmann::json::array()}, {"measured_l_n", nlohmann::json::array()}};
+  nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
+                              {"nodes_v", r.sheet_nodes_v},
+                              {"position_mm", nlohmann::json::array()}};
+  for (const auto& p : r.sheet_end_mm) sheet_end["position_mm"].push_back({p[0], p[1], p[2]});
   for (const auto& x : r.series) {
     series["t_s"].push_back(x.t_s);
     series["force_r_n"].push_back(num(x.force_n[0]));
@@ -365,6 +378,7 @@ nlohmann::json to_json(const TrialResult& r) {
             {"corners_mm", num(s.corners_mm)},
             {"retained_deg", num(s.retained_deg)},
             {"max_stretch", num(s.max_stretch)},
+            {"stretch_at_mm", {num(s.stretch_at_mm[0]), num(s.stretch_at_mm[1])}},
             {"slip_mm", num(s.slip_mm)},
             {"flap_nodes", s.flap_nodes},
             {"folded_nodes", s.folded_nodes},
@@ -381,6 +395,7 @@ nlohmann::json to_json(const TrialResult& r) {
           {"failure", r.failure},
           {"timeline", timeline},
           {"series", series},
+          {"sheet_end", sheet_end},
           {"error", r.error}};
 }
 
@@ -402,6 +417,10 @@ TrialResult from_json(const nlohmann::json& j) {
   r.score.corners_mm = num(s.at("corners_mm"));
   r.score.retained_deg = num(s.at("retained_deg"));
   r.score.max_stretch = num(s.at("max_stretch"));
+  if (s.contains("stretch_at_mm")) {
+    r.score.stretch_at_mm[0] = num(s.at("stretch_at_mm")[0]);
+    r.score.stretch_at_mm[1] = num(s.at("stretch_at_mm")[1]);
+  }
   r.score.slip_mm = num(s.at("slip_mm"));
   r.score.flap_nodes = s.at("flap_nodes").get<int>();
   r.score.folded_nodes = s.at("folded_nodes").get<int>();
@@ -428,6 +447,13 @@ TrialResult from_json(const nlohmann::json& j) {
       if (x.contains("measured_l_n")) v.measured_n[1] = num(x.at("measured_l_n")[k]);
       r.series.push_back(v);
     }
+  }
+  if (j.contains("sheet_end")) {
+    const auto& e = j.at("sheet_end");
+    r.sheet_nodes_u = e.at("nodes_u").get<int>();
+    r.sheet_nodes_v = e.at("nodes_v").get<int>();
+    for (const auto& p : e.at("position_mm"))
+      r.sheet_end_mm.push_back({p[0].get<float>(), p[1].get<float>(), p[2].get<float>()});
   }
   r.error = j.at("error").get<std::string>();
   return r;

@@ -8,6 +8,7 @@
 // buses and plugins are the process's).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -76,6 +77,10 @@ struct TrialResult {
   std::string failure;       // the first reason it is not a success ("" for a success)
   std::vector<TimelineEntry> timeline;
   std::vector<SeriesSample> series;
+  // The world's sheet (the truth grid) the score was taken from, world mm, row-major over u;
+  // empty when no truth came.
+  int sheet_nodes_u = 0, sheet_nodes_v = 0;
+  std::vector<std::array<float, 3>> sheet_end_mm;
   std::string error;
 };
 

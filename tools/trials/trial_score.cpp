@@ -137,7 +137,7 @@ bool fit_base(const SheetState& s, const FoldTarget& t, PlaneMotion& out, int* c
   return ok;
 }
 
-double max_stretch(const SheetState& s) {
+double max_stretch(const SheetState& s, double* at_uv_mm) {
   const int W = s.nodes_u, H = s.nodes_v;
   if (nodes(s) < 4 || nodes(s) > static_cast<int>(SheetState::kMaxNodes)) return kNaN;
   const double du = W > 1 ? s.width_mm / (W - 1) : 1.0, dv = H > 1 ? s.height_mm / (H - 1) : 1.0;
@@ -145,12 +145,17 @@ double max_stretch(const SheetState& s) {
   for (int j = 0; j < H; ++j)
     for (int i = 0; i < W; ++i) {
       const float* x = s.position_mm[j * W + i];
-      auto stretch = [&](const float* y, double rest) {
+      auto stretch = [&](const float* y, double rest, double di, double dj) {
         const double d = std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]));
-        worst = std::max(worst, (d - rest) / rest);
+        const double e = (d - rest) / rest;
+        if (e <= worst) return;
+        worst = e;
+        if (at_uv_mm == nullptr) return;
+        at_uv_mm[0] = du * (i + di);
+        at_uv_mm[1] = dv * (j + dj);
       };
-      if (i + 1 < W) stretch(s.position_mm[j * W + i + 1], du);
-      if (j + 1 < H) stretch(s.position_mm[(j + 1) * W + i], dv);
+      if (i + 1 < W) stretch(s.position_mm[j * W + i + 1], du, 0.5, 0.0);
+      if (j + 1 < H) stretch(s.position_mm[(j + 1) * W + i], dv, 0.0, 0.5);
     }
   return worst;
 }
@@ -238,7 +243,7 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
       zmin = std::min(zmin, double(x[2]));
       below += x[2] < -kBelowTableMm;
     }
-  r.max_stretch = max_stretch(s);
+  r.max_stretch = max_stretch(s, r.stretch_at_mm);
   r.torn = r.max_stretch > kTornStretch;
   r.off_table = below >= kOffTableFraction * W * H;
 
@@ -259,7 +264,8 @@ Score score_sheet(const SheetState& s, const FoldTarget& target, const Bounds& b
 
   char buf[96];
   if (r.torn) {
-    std::snprintf(buf, sizeof buf, "torn (an edge stretched %.1f %%)", 100 * r.max_stretch);
+    std::snprintf(buf, sizeof buf, "torn (an edge stretched %.1f %% at u %.0f v %.0f mm)",
+                  100 * r.max_stretch, r.stretch_at_mm[0], r.stretch_at_mm[1]);
   } else if (r.off_table) {
     std::snprintf(buf, sizeof buf, "off the table (%d of %d nodes below its top, down to %.1f mm)", below, W * H, -zmin);
   } else if (!std::isfinite(r.fold_line_mm)) {

@@ -17,7 +17,7 @@
 //   retained_deg: the angle between the sheet's mean normals either side of the intended line
 //     (kRetainedNearMm .. kRetainedFarMm from it): 0 flat, 180 folded flat;
 //   max_stretch: the largest relative stretch of an edge of the truth grid (its rest length the
-//     grid spacing): torn above kTornStretch;
+//     grid spacing): torn above kTornStretch; stretch_at_mm: that edge's midpoint (u, v);
 //   off_table: kOffTableFraction of the nodes or more lie over kBelowTableMm below the table
 //     top (pushed over an edge; a corner hanging over one, as the shift leaves it for the pinch,
 //     is not);
@@ -62,6 +62,7 @@ struct Score {
   double corners_mm = 0;
   double retained_deg = 0;
   double max_stretch = 0;
+  double stretch_at_mm[2] = {0, 0};  // (u, v) of the most stretched edge's midpoint
   double slip_mm = 0;         // NaN without a reference
   int flap_nodes = 0, folded_nodes = 0, base_nodes = 0;
   bool torn = false;
@@ -91,7 +92,7 @@ struct PlaneMotion {
 bool fit_base(const SheetState& s, const FoldTarget& t, PlaneMotion& out, int* nodes = nullptr);
 
 // The largest relative stretch of an edge of SHEET's grid (its rest length the grid spacing).
-[[nodiscard]] double max_stretch(const SheetState& sheet);
+[[nodiscard]] double max_stretch(const SheetState& sheet, double* at_uv_mm = nullptr);
 
 // The score of SHEET (the world's truth at the end), REFERENCE (the truth the slip is measured
 // from; null: slip NaN).

@@ -206,8 +206,12 @@ TEST_CASE("a torn sheet, one pushed off the table and a base that slipped are to
     const Score r = score_sheet(*s, target(kHalf, kHalfCorner), Bounds{});
     CHECK(r.torn);
     CHECK(r.max_stretch > 0.3);
+    // Where: the edge from (6, 3) to the node pulled away from it, (u, v) of its midpoint.
+    CHECK(r.stretch_at_mm[0] == doctest::Approx(97.5));
+    CHECK(r.stretch_at_mm[1] == doctest::Approx(3 * 297.0 / 20));
     CHECK_FALSE(r.shape_ok);
     CHECK(r.miss.find("torn") == 0);
+    CHECK(r.miss.find("at u 98 v 45 mm") != std::string::npos);
   }
   SUBCASE("off the table: a third of the sheet hanging 40 mm below its top; a corner hanging over an edge is not") {
     s->position_mm[0][2] = -30.0f;
@@ -259,8 +263,19 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(row(a).find("success=1") != std::string::npos);
   // The JSON round trip keeps what the table shows.
   b.series.push_back({0.5, {1.5, 2.0}, 0.02, {1.4, std::nan("")}});
+  b.score.stretch_at_mm[0] = 52.5;
+  b.score.stretch_at_mm[1] = 7.425;
+  b.sheet_nodes_u = 2;
+  b.sheet_nodes_v = 1;
+  b.sheet_end_mm = {{1.5f, -2.0f, 0.25f}, {16.5f, -2.0f, 0.25f}};
   const TrialResult back = from_json(to_json(b));
   CHECK(row(back) == row(b));
+  // ... the worst edge's place and the sheet the score was taken from.
+  CHECK(back.score.stretch_at_mm[0] == 52.5);
+  CHECK(back.score.stretch_at_mm[1] == 7.425);
+  CHECK(back.sheet_nodes_u == 2);
+  CHECK(back.sheet_nodes_v == 1);
+  CHECK(back.sheet_end_mm == b.sheet_end_mm);
   // ... and the series: the world's forces, the stretch, the sensors' forces (NaN: none yet).
   REQUIRE(back.series.size() == 1);
   CHECK(back.series[0].t_s == 0.5);
