@@ -242,7 +242,7 @@ Reason Machine::fault(const Sensing& in) noexcept {
     const HandControlStatus* h = in.hand[s];
     const ArmMotionStatus* a = in.arm[s];
     const ContactState* c = in.contact[s];
-    const Side& n = kSide[s];
+    const Side& n = kSide[side_of_role(spec_, s)];  // s is a role; the names are the side's
     // Controllers that do not answer, or answer that their inputs are bad: a device fault.
     if (h == nullptr || !fresh(h->timestamp_ns, now, spec_.status_max_age_s))
       return found(n.hand_stale, Reason::device_fault);

@@ -107,47 +107,61 @@ TEST_CASE("outside the fold, pause, resume and abort do nothing; start only from
   CHECK(m.phase() == SequenceStatus::idle);
 }
 
-TEST_CASE("an abort on a fault names the input it came from in the status's why") {
+TEST_CASE(
+    "an abort on a fault names the input it came from in the status's why, by the side that plays "
+    "the role") {
+  // half.yaml: the right hand pinches, the left fixes; swapped, the same faults name the other
+  // side.
   const FoldSpec f = half();
+  REQUIRE(f.pinching_side == 0);
+  FoldSpec swapped = f;
+  swapped.pinching_side = 1;
   struct Case {
     const char* name;
     void (*spoil)(Quiet&, std::int64_t now);
-    const char* why;
+    const char* why;          // half.yaml
+    const char* why_swapped;  // the pinching hand the left
     Reason reason;
   };
   const Case cases[] = {
-      {"right contact unhealthy", [](Quiet& q, std::int64_t) { q.contact[0].healthy = 0; },
-       "abort: device_fault: contact_r unhealthy", Reason::device_fault},
-      {"left hand's status 60 ms old",
-       [](Quiet& q, std::int64_t now) { q.hand[1].timestamp_ns = now - 60'000'000; },
-       "abort: device_fault: hand_l status stale", Reason::device_fault},
-      {"left hand's tactile stale",
+      {"fixing contact unhealthy", [](Quiet& q, std::int64_t) { q.contact[kFixing].healthy = 0; },
+       "abort: device_fault: contact_l unhealthy", "abort: device_fault: contact_r unhealthy",
+       Reason::device_fault},
+      {"pinching hand's status 60 ms old",
+       [](Quiet& q, std::int64_t now) { q.hand[kPinching].timestamp_ns = now - 60'000'000; },
+       "abort: device_fault: hand_r status stale", "abort: device_fault: hand_l status stale",
+       Reason::device_fault},
+      {"pinching hand's tactile stale",
        [](Quiet& q, std::int64_t) {
-         q.hand[1].inhibits = 1;
-         q.hand[1].inhibit = HandInhibit::tactile_stale;
+         q.hand[kPinching].inhibits = 1;
+         q.hand[kPinching].inhibit = HandInhibit::tactile_stale;
        },
-       "abort: device_fault: hand_l tactile stale", Reason::device_fault},
-      {"right hand over its force limit",
+       "abort: device_fault: hand_r tactile stale", "abort: device_fault: hand_l tactile stale",
+       Reason::device_fault},
+      {"fixing hand over its force limit",
        [](Quiet& q, std::int64_t) {
-         q.hand[0].inhibits = 1;
-         q.hand[0].inhibit = HandInhibit::force_limit;
+         q.hand[kFixing].inhibits = 1;
+         q.hand[kFixing].inhibit = HandInhibit::force_limit;
        },
-       "abort: force_limit: hand_r force limit", Reason::force_limit},
+       "abort: force_limit: hand_l force limit", "abort: force_limit: hand_r force limit",
+       Reason::force_limit},
   };
-  for (const Case& c : cases) {
-    CAPTURE(c.name);
-    Machine m(f);
-    Quiet q;
-    Outbox out;
-    m.command(Command::start);
-    m.step(q.at(1'000'000), out);
-    Sensing in = q.at(2'000'000);
-    c.spoil(q, 2'000'000);
-    m.step(in, out);
-    SequenceStatus st;
-    m.fill_status(st, 2'000'000);
-    CHECK(std::string(st.path) == "abort/stop");
-    CHECK(std::string(st.why) == c.why);
-    CHECK(st.abort_reason == static_cast<std::uint8_t>(c.reason));
-  }
+  for (const Case& c : cases)
+    for (const bool swap : {false, true}) {
+      CAPTURE(c.name);
+      CAPTURE(swap);
+      Machine m(swap ? swapped : f);
+      Quiet q;
+      Outbox out;
+      m.command(Command::start);
+      m.step(q.at(1'000'000), out);
+      Sensing in = q.at(2'000'000);
+      c.spoil(q, 2'000'000);
+      m.step(in, out);
+      SequenceStatus st;
+      m.fill_status(st, 2'000'000);
+      CHECK(std::string(st.path) == "abort/stop");
+      CHECK(std::string(st.why) == (swap ? c.why_swapped : c.why));
+      CHECK(st.abort_reason == static_cast<std::uint8_t>(c.reason));
+    }
 }
