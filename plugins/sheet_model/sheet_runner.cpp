@@ -5,6 +5,7 @@
 #include <limits>
 #include <utility>
 
+#include "depth_surface_normals.h"
 #include "sheet_state_writer.h"
 #include "xpbd_sheet.h"
 
@@ -83,32 +84,11 @@ void SheetRunner::set_depth_targets(const DepthTargets& t) noexcept {
     depth_node_[n_depth_] = node;
     depth_[n_depth_++] = nt;
   }
-  // The observed surface's normal at each target on a grid node, from the targets of its grid
-  // neighbours (central differences, one-sided at a missing neighbour; none where both neighbours
-  // along u or along v are missing, or the two differences are within 30 deg of parallel).
-  std::fill(node_depth_.begin(), node_depth_.end(), -1);
-  for (int k = 0; k < n_depth_; ++k)
-    if (depth_node_[k] >= 0) node_depth_[depth_node_[k]] = k;
-  const auto at = [&](int i, int j) -> int {
-    return i < 0 || j < 0 || i >= g.w || j >= g.h ? -1 : node_depth_[j * g.w + i];
-  };
-  const auto diff = [&](int a, int c,
-                        int b) -> Vec3 {  // targets a, c, b in a row: b - a, b - c or c - a
-    if (a >= 0 && b >= 0) return depth_[b].world_mm - depth_[a].world_mm;
-    if (c >= 0 && b >= 0) return depth_[b].world_mm - depth_[c].world_mm;
-    if (a >= 0 && c >= 0) return depth_[c].world_mm - depth_[a].world_mm;
-    return Vec3{};
-  };
-  for (int k = 0; k < n_depth_; ++k) {
-    depth_[k].surface_normal = Vec3{};
-    const std::int32_t node = depth_node_[k];
-    if (node < 0) continue;
-    const int i = node % g.w, j = node / g.w;
-    const Vec3 du = diff(at(i - 1, j), k, at(i + 1, j)), dv = diff(at(i, j - 1), k, at(i, j + 1));
-    const Vec3 nrm = cross(du, dv);
-    if (norm(du) > 1e-6 && norm(dv) > 1e-6 && norm(nrm) > 0.5 * norm(du) * norm(dv))
-      depth_[k].surface_normal = normalized(nrm);
-  }
+  // The observed surface's normal at each target on a grid node (depth_surface_normals.h).
+  estimate_surface_normals_rt(
+      g.w, g.h, std::span<NormalTarget>(depth_.data(), static_cast<std::size_t>(n_depth_)),
+      std::span<const std::int32_t>(depth_node_.data(), static_cast<std::size_t>(n_depth_)),
+      node_depth_);
 }
 
 void SheetRunner::apply(const SheetCreaseEvent& e) noexcept {
