@@ -9,6 +9,7 @@
 #include "queue_links.h"
 #include "sheet_edit_mirror.h"
 #include "sheet_mirror.h"
+#include "world_shapes_mirror.h"
 
 namespace crease::dds_bridge {
 
@@ -52,10 +53,12 @@ PayloadKind kind_of() {
   return k;
 }
 
-const PayloadKind kKinds[] = {kind_of<crease::Keypoints>(), kind_of<crease::HandState>(),
-                              kind_of<crease::HandCommand>(), kind_of<crease::ArmState>(),
-                              kind_of<crease::ArmCommand>(), kind_of<crease::SheetState>(),
-                              kind_of<crease::SheetCreaseEvent>(), kind_of<crease::SheetMemorizeEvent>()};
+const PayloadKind kKinds[] = {
+    kind_of<crease::Keypoints>(),        kind_of<crease::HandState>(),
+    kind_of<crease::HandCommand>(),      kind_of<crease::ArmState>(),
+    kind_of<crease::ArmCommand>(),       kind_of<crease::SheetState>(),
+    kind_of<crease::SheetCreaseEvent>(), kind_of<crease::SheetMemorizeEvent>(),
+    kind_of<crease::WorldShapes>()};
 
 }  // namespace
 

@@ -43,9 +43,11 @@ std::string temp_xml(const std::string& name, const std::string& text) {
 TEST_CASE("entries: unknown type or port, a type mismatch, a port with another writer, bad QoS, bad topics") {
   BridgeHost h;
   h.add("source", "crease_test_payload_source", 0, "{}");  // writes hand_state (crease.HandState)
-  CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: p, type: hand_stat}]}"), "subscribe[0].type",
-              "unknown type 'hand_stat' (the bridge carries keypoints, hand_state, hand_command, arm_state, "
-              "arm_command, sheet_state, sheet_crease, sheet_memorize)"));
+  CHECK(names(error_of(h, d() + "subscribe: [{topic: a, port: p, type: hand_stat}]}"),
+              "subscribe[0].type",
+              "unknown type 'hand_stat' (the bridge carries keypoints, hand_state, hand_command, "
+              "arm_state, "
+              "arm_command, sheet_state, sheet_crease, sheet_memorize, world_shapes)"));
   CHECK(names(error_of(h, d() + "publish: [{port: nothing, topic: a}]}"), "publish[0].port",
               "unknown port 'nothing': no plugin configured before this bridge binds it"));
   CHECK(names(error_of(h, d() + "publish: [{port: hand_state, topic: a, type: keypoints}]}"), "publish[0].type",

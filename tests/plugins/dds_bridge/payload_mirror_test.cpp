@@ -1,5 +1,6 @@
 // The copies between port payloads and their IDL's C structs (hand_mirror.h,
-// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h, sheet_edit_mirror.h): a round trip keeps
+// keypoints_mirror.h, arm_mirror.h, sheet_mirror.h, sheet_edit_mirror.h,
+// world_shapes_mirror.h): a round trip keeps
 // every field; the checks on the way in refuse non-finite and out-of-range values, inconsistent
 // lengths and more entries than the payload holds.
 #include <doctest/doctest.h>
@@ -13,6 +14,7 @@
 #include "keypoints_mirror.h"
 #include "sheet_edit_mirror.h"
 #include "sheet_mirror.h"
+#include "world_shapes_mirror.h"
 
 using namespace crease;
 using crease::dds_bridge::Dds;
@@ -262,4 +264,58 @@ TEST_CASE("sheet_crease and sheet_memorize: a round trip keeps every field; bad 
   mc.whole_sheet = true;
   mc.max_mm[0] = INFINITY;
   CHECK(Dds<SheetMemorizeEvent>::from_dds(mc, mback) == SampleCheck::malformed);
+}
+
+TEST_CASE(
+    "world_shapes: only `count` shapes travel, every field kept; out-of-range and oversized "
+    "samples are refused") {
+  auto w = std::make_unique<WorldShapes>();
+  w->timestamp_ns = 123;
+  w->step = 456;
+  w->count = 3;
+  w->reserved = 9;  // does not travel
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    WorldShapes::Shape& s = w->shapes[i];
+    s.kind = static_cast<WorldShapes::Kind>(i + 1);
+    s.role = static_cast<WorldShapes::Role>(2 * i);
+    s.side = static_cast<std::uint8_t>(i % 2);
+    s.radius_mm = 8.5f + i;
+    s.half_length_mm = 12.0f;
+    s.half_mm[0] = 1.0f;
+    s.half_mm[1] = 2.0f;
+    s.half_mm[2] = 3.0f;
+    s.position_mm[0] = 100.0f * i;
+    s.position_mm[2] = -5.0f;
+    s.rotation[1] = 0.5f;  // any 9 numbers travel as they are
+  }
+  auto c = std::make_unique<Dds<WorldShapes>::C>();
+  auto scratch = std::make_unique<Dds<WorldShapes>::Scratch>();
+  Dds<WorldShapes>::to_dds(*w, *c, *scratch);
+  CHECK(c->shapes._length == 3);
+  CHECK(c->shapes._buffer == scratch->shapes);
+  CHECK(c->step == 456);
+  auto back = std::make_unique<WorldShapes>();
+  back->reserved = 7;
+  REQUIRE(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::ok);
+  CHECK(back->timestamp_ns == 123);
+  CHECK(back->step == 456);
+  CHECK(back->count == 3);
+  CHECK(back->reserved == 0);
+  CHECK(std::memcmp(back->shapes, w->shapes, 3 * sizeof(WorldShapes::Shape)) == 0);
+
+  scratch->shapes[1].kind = 4;  // past box
+  CHECK(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::malformed);
+  scratch->shapes[1].kind = 0;
+  scratch->shapes[1].role = 7;  // past arm
+  CHECK(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::malformed);
+  scratch->shapes[1].role = 0;
+  scratch->shapes[1].side = 2;
+  CHECK(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::malformed);
+  scratch->shapes[1].side = 0;
+  scratch->shapes[2].rotation[4] = INFINITY;
+  CHECK(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::malformed);
+  scratch->shapes[2].rotation[4] = 1.0f;
+  REQUIRE(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::ok);
+  c->shapes._length = WorldShapes::kCapacity + 1;
+  CHECK(Dds<WorldShapes>::from_dds(*c, *back) == SampleCheck::oversized);
 }
