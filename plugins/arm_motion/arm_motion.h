@@ -67,7 +67,7 @@ struct MotionParams {
   double hand_state_max_age_s = 0.02;
   double contact_state_max_age_s = 0.005;
   double sheet_state_max_age_s = 0.2;      // (the plugin checks it)
-  int check_samples_per_cycle = 2;
+  int check_samples_per_cycle = 1;
   double check_step_mm = 5.0;
   double check_step_rad = 0.05;
   double joint_speed_fraction = 0.9;       // of the URDF's velocity limits

@@ -15,7 +15,7 @@
 //   hand_state_max_age_ms: 20        # a hand tool frame's goal needs one this fresh
 //   contact_state_max_age_ms: 5      # a stop condition needs one this fresh
 //   sheet_state_max_age_ms: 200      # a sheet-frame goal needs one this fresh
-//   check_samples_per_cycle: 2       # path samples solved ahead per cycle before a motion runs
+//   check_samples_per_cycle: 1       # path samples solved ahead per cycle before a motion runs
 //   check_step_mm: 5                 # their spacing (and check_step_rad in rotation)
 //   check_step_rad: 0.05
 //   joint_speed_fraction: 0.9        # of each joint's URDF velocity limit a path may need
