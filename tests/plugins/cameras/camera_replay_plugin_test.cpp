@@ -27,6 +27,7 @@
 #include "core/port_types/keypoints.h"
 #include "core/port_types/sheet_state.h"
 #include "rt/clock.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
@@ -41,13 +42,7 @@ struct Host {
   crease::PluginHost host{{CREASE_PLUGIN_DIR}};
   void add(const std::string& name, const std::string& library, const std::string& loop, int order,
            const std::string& yaml) {
-    crease::InstanceSpec s;
-    s.name = name;
-    s.library = library;
-    s.loop = loop;
-    s.order = order;
-    s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
-    host.add_instance(s);
+    host.add_instance(crease::testing::instance_spec(name, library, loop, order, yaml));
   }
   template <class T>
   bool read(const std::string& port, T& out) {

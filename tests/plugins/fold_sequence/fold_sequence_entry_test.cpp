@@ -16,18 +16,15 @@
 #include "core/port_types/hand_goal.h"
 #include "core/port_types/sequence_status.h"
 #include "plugins/fold_sequence/fold_sequence_plugin.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 
 namespace {
 
 crease::InstanceSpec spec(const std::string& fold) {
-  crease::InstanceSpec s;
-  s.name = "fold";
-  s.library = "fold_sequence";
-  s.loop = "control";
-  s.params = crease::Params(YAML::Load("{fold: " + fold + "}"), "test.yaml", "fold.params");
-  return s;
+  return crease::testing::instance_spec("fold", "fold_sequence", "control", 0,
+                                        "{fold: " + fold + "}");
 }
 
 crease::SequenceStatus status(const crease::PluginHost& host) {

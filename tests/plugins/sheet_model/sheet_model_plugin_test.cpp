@@ -14,6 +14,7 @@
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
 #include "support/host_poll.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 
@@ -22,11 +23,7 @@ namespace {
 // The sheet instance in the model loop. No time budget: the tests check what the model
 // computes, and a sanitizer build on a slow machine takes longer than the 120 Hz period.
 crease::InstanceSpec sheet_spec(const char* yaml) {
-  crease::InstanceSpec s;
-  s.name = "sheet";
-  s.library = "sheet_model";
-  s.loop = "model";
-  s.params = crease::Params(YAML::Load(yaml), "test.yaml", "sheet.params");
+  crease::InstanceSpec s = crease::testing::instance_spec("sheet", "sheet_model", "model", 0, yaml);
   s.budget_ns = 0;
   return s;
 }

@@ -1,13 +1,13 @@
 // The sheet_score plugin in a loop: a model 2 mm above the truth scores 2 mm per frame, the
 // figure names itself, and the recording has one line per model frame.
 #include <doctest/doctest.h>
-#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
@@ -16,6 +16,7 @@
 #include "core/port_types/sheet_state.h"
 #include "rt/alloc_guard.h"
 #include "rt/clock.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 using crease::Figure;
@@ -25,12 +26,8 @@ TEST_CASE("sheet_score: scores every model frame against the truth and records i
   const std::string path = "/tmp/crease-score-" + std::to_string(::getpid()) + ".jsonl";
   crease::PluginHost host({CREASE_PLUGIN_DIR});
   host.add_loop({"model", 200.0, 0, -1});
-  crease::InstanceSpec s;
-  s.name = "score";
-  s.library = "sheet_score";
-  s.loop = "model";
-  s.params = crease::Params(YAML::Load("{record: " + path + "}"), "test.yaml", "score.params");
-  host.add_instance(s);
+  host.add_instance(
+      crease::testing::instance_spec("score", "sheet_score", "model", 0, "{record: " + path + "}"));
   auto* model = host.ports().bind_latest_writer("sheet_state", crease::port_type_of<SheetState>(), "test");
   auto* truth = host.ports().bind_latest_writer("sheet_truth", crease::port_type_of<SheetState>(), "test");
   auto st = std::make_unique<SheetState>();
@@ -72,13 +69,9 @@ TEST_CASE("sheet_score: scores every model frame against the truth and records i
 TEST_CASE("sheet_score: a record file that cannot be written is a configuration error naming the key") {
   crease::PluginHost host({CREASE_PLUGIN_DIR});
   host.add_loop({"model", 60.0, 0, -1});
-  crease::InstanceSpec s;
-  s.name = "score";
-  s.library = "sheet_score";
-  s.loop = "model";
-  s.params = crease::Params(YAML::Load("{record: /nonexistent-dir/x.jsonl}"), "test.yaml", "score.params");
   try {
-    host.add_instance(s);
+    host.add_instance(crease::testing::instance_spec("score", "sheet_score", "model", 0,
+                                                     "{record: /nonexistent-dir/x.jsonl}"));
     FAIL("must throw");
   } catch (const std::exception& e) {
     const std::string what = e.what();

@@ -9,6 +9,7 @@
 
 #include "core/plugin_host.h"
 #include "core/port_types/sheet_state.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 using crease::SheetState;
@@ -16,14 +17,9 @@ using crease::SheetState;
 TEST_CASE("sheet_truth folds without announcing a crease to the model") {
   crease::PluginHost host({CREASE_PLUGIN_DIR});
   host.add_loop({"model", 60.0, 0, -1});
-  auto add = [&](const std::string& name, const std::string& library, int order, const std::string& yaml) {
-    crease::InstanceSpec s;
-    s.name = name;
-    s.library = library;
-    s.loop = "model";
-    s.order = order;
-    s.params = crease::Params(YAML::Load(yaml), "test.yaml", name + ".params");
-    host.add_instance(s);
+  auto add = [&](const std::string& name, const std::string& library, int order,
+                 const std::string& yaml) {
+    host.add_instance(crease::testing::instance_spec(name, library, "model", order, yaml));
   };
   add("truth", "sheet_truth", 1, "{start_s: 0, origin_x_mm: 0, origin_y_mm: 297}");
   add("sheet", "sheet_model", 10, "{}");

@@ -21,6 +21,7 @@
 #include "plugins/sim_world/scene/sim_source.h"
 #include "rt/alloc_guard.h"
 #include "support/host_poll.h"
+#include "support/instance_spec.h"
 
 using namespace std::chrono_literals;
 using namespace crease::vision;
@@ -68,12 +69,7 @@ struct Fixture {
   // `channel`: the global name of the plugin's `images` port (empty: the default, "images").
   void add(const std::string& name, const std::string& library, int order,
            const std::string& yaml, const std::string& channel = "") {
-    crease::InstanceSpec s;
-    s.name = name;
-    s.library = library;
-    s.loop = "vision";
-    s.order = order;
-    s.params = crease::Params(YAML::Load(yaml), kSrc + "/config/test.yaml", name + ".params");
+    crease::InstanceSpec s = crease::testing::instance_spec(name, library, "vision", order, yaml);
     if (!channel.empty()) s.ports["images"] = channel;
     host.add_instance(s);
   }
