@@ -174,12 +174,35 @@ void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
   if (m_.leaf != S::abort_lift && m_.leaf != S::abort_park) return;
   for (int s = 0; s < 2; ++s) {
     const ArmMotionStatus* a = in.arm[s];
-    if (joints_park_due(s, in)) {
-      m_.park_joints[s] = 1;
+    if (joints_park_due(s, in) && spec_.park_lift_mm > 0) {  // up first, then in joint space
+      m_.park_joints[s] = Memory::kParkLifting;
+      m_.park_lift_mm[s] = spec_.park_lift_mm;
+      out.park_lift[s] = true;
+      arm_lift(s, m_.park_lift_mm[s], out);
+      continue;
+    }
+    const RetreatEnd lift_end = m_.park_joints[s] == Memory::kParkLifting
+                                    ? retreat_end(a, m_.arm_id[s])
+                                    : RetreatEnd::pending;
+    if (lift_end == RetreatEnd::gave_up && m_.park_lift_mm[s] * 0.5 >= Memory::kMinParkLiftMm) {
+      const auto why = static_cast<ArmMotionReason>(end_reason(*a, m_.arm_id[s]));
+      if (why == ArmMotionReason::unreachable ||
+          why == ArmMotionReason::joint_speed) {  // a shorter lift
+        m_.park_lift_mm[s] *= 0.5;
+        out.park_lift[s] = true;
+        arm_lift(s, m_.park_lift_mm[s], out);
+        continue;
+      }
+    }
+    const bool lifted = lift_end != RetreatEnd::pending;
+    if (lifted ||
+        joints_park_due(s, in)) {  // the lift ended (reached or short): the park, in joint space
+      m_.park_joints[s] = Memory::kParkJoints;
       out.joints_park[s] = true;
       arm_park(s, out, true);
       continue;
     }
+    if (m_.park_joints[s] == Memory::kParkLifting) continue;  // rising
     if (retreat_end(a, m_.arm_id[s]) != RetreatEnd::retry ||
         static_cast<double>(m_.last_ns - m_.arm_sent_ns[s]) * 1e-9 < kRetryS)
       continue;
@@ -367,6 +390,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::finish_park:
     case S::abort_park:
       m_.park_joints[0] = m_.park_joints[1] = 0;
+      m_.park_lift_mm[0] = m_.park_lift_mm[1] = 0;
       arm_park(kFixing, out);
       arm_park(kPinching, out);
       break;

@@ -118,7 +118,9 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
     case Ev::arms_done:
       for (int s = 0; s < 2; ++s) {
         const RetreatEnd e = retreat_end(in.arm[s], m_.arm_id[s]);
-        if ((e != RetreatEnd::reached && e != RetreatEnd::gave_up) || joints_park_due(s, in)) return false;
+        if ((e != RetreatEnd::reached && e != RetreatEnd::gave_up) || joints_park_due(s, in) ||
+            (m_.leaf == S::abort_park && m_.park_joints[s] == Memory::kParkLifting))
+          return false;
       }
       return true;
     case Ev::always: return true;

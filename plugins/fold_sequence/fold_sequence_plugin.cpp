@@ -112,6 +112,12 @@ void FoldSequencePlugin::log_retreat(const Outbox& out) const noexcept {
          {"retreat: the fixing arm's goal ended short (arm_motion reason), sent again",
           "retreat: the pinching arm's goal ended short (arm_motion reason), sent again"},
          out.retried[r]},
+        {out.park_lift[r],
+         {"retreat: the fixing arm's park, out of reach on a line: the hand lifted first "
+          "(park_lift_mm)",
+          "retreat: the pinching arm's park, out of reach on a line: the hand lifted first "
+          "(park_lift_mm)"},
+         -1},
         {out.joints_park[r],
          {"retreat: the fixing arm's park, out of reach on a line, sent in joint space",
           "retreat: the pinching arm's park, out of reach on a line, sent in joint space"},

@@ -233,6 +233,7 @@ void read(const Params& p, FoldSpec& f) {
   numbers(rf, "out_mm", 2, f.refixate_out_mm);
   f.refixate_out_force_n = rf.get_in_range<double>("out_force_n", 0.5, 0.0, 10.0);
   f.release_lift_mm = p.get_in_range<double>("release_lift_mm", 30.0, 0.0, 300.0);
+  f.park_lift_mm = p.get_in_range<double>("park_lift_mm", 150.0, 0.0, 500.0);
   const Params sw = p.child("swipe");
   f.swipe = contact_step(sw, 0, true);
   sheet_point(sw, "withdraw_mm", f.swipe_withdraw_mm);

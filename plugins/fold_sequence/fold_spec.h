@@ -110,6 +110,10 @@ struct FoldSpec {
   double refixate_out_force_n = 0.5;
   ContactStep refixate;
   double release_lift_mm = 30;     // a hand lifts this far after it opened (e, f, g)
+  // The abort's park out of reach on a line goes in joint space; first the hand is lifted this
+  // far straight up (0: not): the joints' own path from a wrist turned by the bend can swing
+  // the hand through the table (trials: world fingertip forces of 1-2 kN in abort/park).
+  double park_lift_mm = 150;
 
   // (f) the pinch opens to prepinch_rad (the thumb off the edge), its tool moves to
   // swipe_withdraw_mm (sheet frame, the pads off the edge), the hand opens and lifts; the coarse

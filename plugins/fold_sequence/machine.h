@@ -79,11 +79,12 @@ struct Outbox {
   std::uint8_t retried[2] = {kNoRetry, kNoRetry};
   std::uint8_t gave_up[2] = {kNoRetry, kNoRetry};  // ... or ended it for good, and why
   bool joints_park[2] = {false, false};  // ... or sent the park again in joint space
+  bool park_lift[2] = {false, false};    // ... or lifted the hand before that (park_lift_mm)
   void clear() noexcept {
     arm_count[0] = arm_count[1] = hand_count[0] = hand_count[1] = 0;
     has_crease = has_memorize = overflow = false;
     retried[0] = retried[1] = gave_up[0] = gave_up[1] = kNoRetry;
-    joints_park[0] = joints_park[1] = false;
+    joints_park[0] = joints_park[1] = park_lift[0] = park_lift[1] = false;
   }
 };
 
@@ -92,8 +93,9 @@ enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, 
 struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
-  // retreat's retries (arm_sent_ns, gave_up_id, park_joints)
-  static constexpr std::uint32_t kVersion = 4;
+  // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
+  // park in joint space, halved while out of reach)
+  static constexpr std::uint32_t kVersion = 5;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -127,7 +129,14 @@ struct Memory {
   std::uint8_t arm_tool[2] = {0, 0};
   std::int64_t arm_sent_ns[2] = {0, 0};  // when the last move goal was sent
   std::uint32_t gave_up_id[2] = {0, 0};  // the last retreat goal reported as ended for good
-  std::uint8_t park_joints[2] = {0, 0};  // the park was sent again in joint space (joints_park_due)
+  // The park out of reach on a line (joints_park_due): kParkLifting while the hand rises by
+  // park_lift_mm, kParkJoints once the park was sent again in joint space.
+  static constexpr std::uint8_t kParkLifting = 2, kParkJoints = 1;
+  std::uint8_t park_joints[2] = {0, 0};
+  // The lift now tried before the park in joint space (mm): park_lift_mm, halved each time it
+  // is out of reach (unreachable, joint_speed) down to kMinParkLiftMm, then the park as it is.
+  static constexpr double kMinParkLiftMm = 20.0;
+  double park_lift_mm[2] = {0, 0};
   double arm_target[2][3] = {};       // the last move goal's target (its frame)
   double arm_orientation[2][4] = {};
   std::uint32_t crease_count0 = 0;    // sheet_state's creases when the crease was sent

@@ -4,9 +4,12 @@
 // hands open, the operator's commands, a hot-swap resuming in the same state, and no
 // allocation on the update path.
 #include <doctest/doctest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 #include <vector>
@@ -444,8 +447,9 @@ TEST_CASE("the abort opens the hands again once lifted, before the park") {
 // aborted as arm_stale, the park was refused as arm_not_ready, and the retreat ended with a
 // hand 14 mm over the sheet): a lift or park that ended short for such a reason is sent again,
 // at most every kRetryS, until it is reached or the state times out. A park out of reach on a
-// line (unreachable) is sent once more in joint space; one refused for good after it is not sent
-// again. A park refused behind the hand's retreat opens it again first.
+// line (unreachable) is sent once more in joint space, after a lift of park_lift_mm (the joints'
+// path from a turned wrist swung a hand through the table in the trials); one refused for good
+// after it is not sent again. A park refused behind the hand's retreat opens it again first.
 TEST_CASE("the retreat sends a lift or park again that ended short for a reason that may pass") {
   using crease::fold::kRetryS;
   const auto moves_after = [](const Rig& r, long from) {
@@ -482,7 +486,9 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
       if (sent[k]->arm_goal.frame == sent[k - 1]->arm_goal.frame && sent[k]->arm_goal.kind == ArmGoal::move)
         CHECK(sent[k]->cycle - sent[k - 1]->cycle >= static_cast<long>(kRetryS * 1000));
   }
-  SUBCASE("a park out of reach on a line is sent once in joint space, and reached so") {
+  SUBCASE(
+      "a park out of reach on a line: the hand lifted park_lift_mm first, then the park once in "
+      "joint space, reached so") {
     Rig r;
     const long abort_at = start_and_run_to(r, "fold/shift/press");
     r.refuse_as = [&](int s, const ArmGoal& g, int) {
@@ -492,14 +498,77 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
     r.command(Command::abort);
     REQUIRE(r.run_to("aborted", 20000));
     const auto g = moves_after(r, abort_at);
-    REQUIRE(g.size() == 3);  // the lift, the park on a line (refused), the park in joint space
+    // the lift, the park on a line (refused), the lift of park_lift_mm, the park in joint space
+    REQUIRE(g.size() == 4);
     CHECK(g[1]->interpolation == ArmGoal::cartesian);
-    CHECK(g[2]->interpolation == ArmGoal::joints);
-    CHECK(g[2]->frame == ArmGoal::world);
-    CHECK(g[2]->position_mm[0][2] == 300.0);
+    CHECK(g[2]->frame == ArmGoal::measured);
+    CHECK(g[2]->position_mm[0][2] == 150.0);
+    CHECK(g[3]->interpolation == ArmGoal::joints);
+    CHECK(g[3]->frame == ArmGoal::world);
+    CHECK(g[3]->position_mm[0][2] == 300.0);
+    // The joint-space park only once the lift ended (the rig's motions take 20 cycles).
+    const auto sent = r.all(kFix, Sent::arm, abort_at);
+    long lift_at = -1, park_at = -1;
+    for (const Sent* x : sent) {
+      if (x->arm_goal.kind != ArmGoal::move) continue;
+      if (x->arm_goal.frame == ArmGoal::measured && x->arm_goal.position_mm[0][2] == 150.0)
+        lift_at = x->cycle;
+      if (x->arm_goal.interpolation == ArmGoal::joints) park_at = x->cycle;
+    }
+    REQUIRE(lift_at >= 0);
+    CHECK(park_at - lift_at >= 20);
     const auto other = r.all(kPin, Sent::arm, abort_at);  // the pinching arm's park went on a line
     REQUIRE(!other.empty());
     CHECK(other.back()->arm_goal.interpolation == ArmGoal::cartesian);
+  }
+  SUBCASE(
+      "a park's lift out of reach is halved until taken (150 refused, 75 reached), then the park "
+      "in joint space") {
+    Rig r;
+    const long abort_at = start_and_run_to(r, "fold/shift/press");
+    r.refuse_as = [&](int s, const ArmGoal& g, int) {
+      if (s != kFix) return ArmMotionReason::none;
+      if (g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian)
+        return ArmMotionReason::unreachable;
+      if (g.frame == ArmGoal::measured && g.position_mm[0][2] > 100.0f)
+        return ArmMotionReason::unreachable;
+      return ArmMotionReason::none;
+    };
+    r.command(Command::abort);
+    REQUIRE(r.run_to("aborted", 20000));
+    const auto g = moves_after(r, abort_at);
+    // the lift, the park on a line (refused), the park's lift of 150 (refused), of 75, the park in
+    // joint space
+    REQUIRE(g.size() == 5);
+    CHECK(g[2]->position_mm[0][2] == 150.0);
+    CHECK(g[3]->frame == ArmGoal::measured);
+    CHECK(g[3]->position_mm[0][2] == 75.0);
+    CHECK(g[4]->interpolation == ArmGoal::joints);
+  }
+  SUBCASE(
+      "with park_lift_mm 0 the park goes in joint space straight from where the line park was "
+      "refused") {
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("crease_fold_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    {
+      std::ifstream in(fold_file("half.yaml"));
+      std::ofstream out(dir / "half.yaml");
+      out << in.rdbuf() << "\npark_lift_mm: 0\n";
+    }
+    Rig r((dir / "half.yaml").string());
+    const long abort_at = start_and_run_to(r, "fold/shift/press");
+    r.refuse_as = [&](int s, const ArmGoal& g, int) {
+      return s == kFix && g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian
+                 ? ArmMotionReason::unreachable
+                 : ArmMotionReason::none;
+    };
+    r.command(Command::abort);
+    REQUIRE(r.run_to("aborted", 20000));
+    const auto g = moves_after(r, abort_at);
+    REQUIRE(g.size() == 3);  // the lift, the park on a line (refused), the park in joint space
+    CHECK(g[2]->interpolation == ArmGoal::joints);
+    std::filesystem::remove_all(dir);
   }
   SUBCASE("a park out of reach in joint space too is not sent again: the retreat ends at once") {
     Rig r;
@@ -512,7 +581,8 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
     const long park_at = r.cycles();
     REQUIRE(r.run_to("aborted", 1000));
     CHECK(r.cycles() - park_at < static_cast<long>(kRetryS * 1000));
-    CHECK(moves_after(r, abort_at).size() == 3);  // the lift, the park on a line, in joint space
+    CHECK(moves_after(r, abort_at).size() ==
+          4);  // the lift, the park on a line, the park's lift, in joint space
   }
   SUBCASE("a park refused behind the hand's retreat: the hand opened again, then the park") {
     Rig r;
