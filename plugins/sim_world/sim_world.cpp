@@ -8,6 +8,7 @@
 
 #include "core/errors.h"
 #include "plugins/sheet_model/sheet_state_writer.h"
+#include "plugins/sim_world/table_contact.h"
 
 namespace crease::world {
 namespace {
@@ -273,11 +274,19 @@ void World::settle_hand_rt(int side) noexcept {
     shape_normal_n_[k] = 0;
     shape_normal_vec_n_[k] = Vec3{};
     if (!params_.hand_contacts || !s.compliant) continue;
-    const Vec3 low = lowest_point(s.geom, pose_pre_[k]);
-    if (!over_table(low)) continue;
-    const double depth = params_.table_height_mm - low.z;
-    if (depth <= -kTableGapMm) continue;  // a gap that may close counts too (hand_compliance.h)
-    contacts[n] = {s.link, low, {0, 0, -1}, depth, s.stiffness_n_per_mm3 * params_.table_contact_area_mm2, -1, {}, {}};
+    const TableContact t = table_contact(s.geom, pose_pre_[k], params_.table_height_mm,
+                                         params_.table_extent_mm.data());
+    if (!t.over) continue;
+    if (t.depth_mm <= -kTableGapMm)
+      continue;  // a gap that may close counts too (hand_compliance.h)
+    contacts[n] = {s.link,
+                   t.point,
+                   t.normal,
+                   t.depth_mm,
+                   s.stiffness_n_per_mm3 * params_.table_contact_area_mm2,
+                   -1,
+                   {},
+                   {}};
     shape_of[n] = k;
     shape2_of[n++] = -1;
   }
@@ -305,8 +314,9 @@ double World::geometric_penetration_mm() const noexcept {
   const auto x = sheet_->positions();
   for (const WorldShape& s : shapes_) {
     if (!s.compliant) continue;
-    const Vec3 low = lowest_point(s.geom, s.pose1);
-    if (over_table(low)) worst = std::max(worst, params_.table_height_mm - low.z);
+    const TableContact t =
+        table_contact(s.geom, s.pose1, params_.table_height_mm, params_.table_extent_mm.data());
+    if (t.over) worst = std::max(worst, t.depth_mm);
     double e[3];
     for (int a = 0; a < 3; ++a) e[a] = half_extent(s.geom, s.pose1, a) + h;
     for (const Vec3& p : x) {
@@ -328,8 +338,9 @@ void World::measure_penetration_rt() noexcept {
   for (const FingerContacts::Residual& r : contacts_.residuals()) worst = std::max(worst, r.depth_mm);
   if (params_.hand_contacts) {
     for (const WorldShape& s : shapes_) {
-      const Vec3 low = lowest_point(s.geom, s.pose1);
-      if (over_table(low)) worst = std::max(worst, params_.table_height_mm - low.z);
+      const TableContact t =
+          table_contact(s.geom, s.pose1, params_.table_height_mm, params_.table_extent_mm.data());
+      if (t.over) worst = std::max(worst, t.depth_mm);
     }
   }
   max_penetration_mm_ = worst;
