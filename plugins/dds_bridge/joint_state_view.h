@@ -23,6 +23,7 @@
 #include "JointState.h"
 #include "core/port_types/arm.h"
 #include "core/port_types/hand.h"
+#include "mirror.h"
 #include "plugins/robot_model/robot_layout.h"
 
 namespace crease::dds_bridge {
@@ -96,10 +97,8 @@ struct JointStateView {
  private:
   template <class Seq, class E>
   static void set(Seq& seq, E* data, int n) noexcept {
-    seq._maximum = static_cast<std::uint32_t>(n);
-    seq._length = static_cast<std::uint32_t>(n);
-    seq._buffer = n > 0 ? data : nullptr;
-    seq._release = false;
+    const auto len = static_cast<std::uint32_t>(n);
+    lend_sequence(seq, n > 0 ? data : nullptr, len, len);
   }
 };
 

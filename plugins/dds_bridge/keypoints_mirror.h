@@ -57,10 +57,7 @@ struct Dds<crease::Keypoints> {
     CREASE_KEYPOINTS_HEADER_FIELDS(CREASE_DDS_COPY_, CREASE_DDS_COPY_)
     const std::uint32_t n = src.count <= crease::Keypoints::kCapacity ? src.count : crease::Keypoints::kCapacity;
     for (std::uint32_t i = 0; i < n; ++i) copy_point(src.points[i], scratch.points[i]);
-    dst.points._maximum = crease::Keypoints::kCapacity;
-    dst.points._length = n;
-    dst.points._buffer = scratch.points;
-    dst.points._release = false;
+    lend_sequence(dst.points, scratch.points, n, crease::Keypoints::kCapacity);
   }
   static SampleCheck from_dds(const C& src, crease::Keypoints& dst) noexcept {
     if (src.points._length > crease::Keypoints::kCapacity) return SampleCheck::oversized;

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <type_traits>
 
@@ -48,6 +49,17 @@ inline void copy_field(D& dst, const S& src) noexcept {
   } else {
     dst = static_cast<D>(src);
   }
+}
+
+// Lends a sequence of the generated C (dds_sequence_*: _maximum, _length, _buffer, _release) the
+// first LENGTH elements at BUFFER, which it does not own: dds_write only reads them.
+template <class Seq, class E>
+inline void lend_sequence(Seq& seq, E* buffer, std::uint32_t length,
+                          std::uint32_t maximum) noexcept {
+  seq._maximum = maximum;
+  seq._length = length;
+  seq._buffer = buffer;
+  seq._release = false;
 }
 
 }  // namespace crease::dds_bridge

@@ -1,21 +1,21 @@
 // The port payloads a bridge can carry, each with its IDL type (idl/*.idl) and how to make a
 // publish or subscribe link for a port of it. Non-RT.
 //
+// clang-format off
 //   type          port payload          DDS type (ROS 2 name)
-//   keypoints     crease::Keypoints     crease_msgs::msg::dds_::Keypoints_
-//   (crease_msgs/msg/Keypoints) hand_state    crease::HandState crease_msgs::msg::dds_::HandState_
-//   (crease_msgs/msg/HandState) hand_command  crease::HandCommand
-//   crease_msgs::msg::dds_::HandCommand_ (crease_msgs/msg/HandCommand) arm_state crease::ArmState
-//   crease_msgs::msg::dds_::ArmState_    (crease_msgs/msg/ArmState) arm_command crease::ArmCommand
-//   crease_msgs::msg::dds_::ArmCommand_  (crease_msgs/msg/ArmCommand) sheet_state
-//   crease::SheetState    crease_msgs::msg::dds_::SheetState_  (crease_msgs/msg/SheetState)
-//   world_shapes  crease::WorldShapes   crease_msgs::msg::dds_::WorldShapes_
-//   (crease_msgs/msg/WorldShapes)
+//   keypoints     crease::Keypoints     crease_msgs::msg::dds_::Keypoints_   (crease_msgs/msg/Keypoints)
+//   hand_state    crease::HandState     crease_msgs::msg::dds_::HandState_   (crease_msgs/msg/HandState)
+//   hand_command  crease::HandCommand   crease_msgs::msg::dds_::HandCommand_ (crease_msgs/msg/HandCommand)
+//   arm_state     crease::ArmState      crease_msgs::msg::dds_::ArmState_    (crease_msgs/msg/ArmState)
+//   arm_command   crease::ArmCommand    crease_msgs::msg::dds_::ArmCommand_  (crease_msgs/msg/ArmCommand)
+//   sheet_state   crease::SheetState    crease_msgs::msg::dds_::SheetState_  (crease_msgs/msg/SheetState)
+//   world_shapes  crease::WorldShapes   crease_msgs::msg::dds_::WorldShapes_ (crease_msgs/msg/WorldShapes)
 // and two of queue ports (events, each delivered once, in order: queue_links.h):
 //   sheet_crease   crease::SheetCreaseEvent   crease_msgs::msg::dds_::SheetCreaseEvent_
 //   sheet_memorize crease::SheetMemorizeEvent crease_msgs::msg::dds_::SheetMemorizeEvent_
 // hand_state and arm_state also publish as sensor_msgs/msg/JointState (`view: joint_state`,
 // joint_state_view.h).
+// clang-format on
 #pragma once
 
 #include <memory>

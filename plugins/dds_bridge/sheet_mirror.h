@@ -104,10 +104,7 @@ struct Dds<crease::SheetState> {
  private:
   template <class Seq, class E>
   static void point(Seq& seq, const E* data, std::uint32_t n) noexcept {
-    seq._maximum = n;
-    seq._length = n;
-    seq._buffer = const_cast<E*>(data);  // only read by dds_write
-    seq._release = false;
+    lend_sequence(seq, const_cast<E*>(data), n, n);  // only read by dds_write
   }
   template <class E, class Seq>
   static void take(E* out, const Seq& seq) noexcept {

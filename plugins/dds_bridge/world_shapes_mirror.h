@@ -65,10 +65,7 @@ struct Dds<crease::WorldShapes> {
     const std::uint32_t n =
         src.count <= crease::WorldShapes::kCapacity ? src.count : crease::WorldShapes::kCapacity;
     for (std::uint32_t i = 0; i < n; ++i) copy_shape(src.shapes[i], scratch.shapes[i]);
-    dst.shapes._maximum = crease::WorldShapes::kCapacity;
-    dst.shapes._length = n;
-    dst.shapes._buffer = scratch.shapes;
-    dst.shapes._release = false;
+    lend_sequence(dst.shapes, scratch.shapes, n, crease::WorldShapes::kCapacity);
   }
   // A kind, role or side out of its enum's range is malformed; more shapes than kCapacity
   // oversized.
