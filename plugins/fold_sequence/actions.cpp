@@ -170,39 +170,45 @@ void Machine::stop_for_pause(Outbox& out) noexcept {
   for (int s = 0; s < 2; ++s) m_.hand_id[s] = 0;
 }
 
+bool Machine::park_out_of_reach(int s, const Sensing& in, Outbox& out) noexcept {
+  const auto lift = [&](double mm) {
+    m_.park_joints[s] = Memory::kParkLifting;
+    m_.park_lift_mm[s] = mm;
+    out.park_lift[s] = true;
+    arm_lift(s, mm, out);
+  };
+  const auto park_in_joints = [&] {
+    m_.park_joints[s] = Memory::kParkJoints;
+    out.joints_park[s] = true;
+    arm_park(s, out, true);
+  };
+  if (joints_park_due(s, in)) {  // the park on a line out of reach: up first, then in joint space
+    if (spec_.park_lift_mm > 0)
+      lift(spec_.park_lift_mm);
+    else
+      park_in_joints();
+    return true;
+  }
+  if (m_.park_joints[s] != Memory::kParkLifting) return false;
+  const ArmMotionStatus* a = in.arm[s];
+  const RetreatEnd e = retreat_end(a, m_.arm_id[s]);
+  if (e == RetreatEnd::pending) return true;  // rising
+  if (e == RetreatEnd::gave_up && m_.park_lift_mm[s] * 0.5 >= Memory::kMinParkLiftMm) {
+    const auto why = static_cast<ArmMotionReason>(end_reason(*a, m_.arm_id[s]));
+    if (why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed) {
+      lift(m_.park_lift_mm[s] * 0.5);  // a shorter lift
+      return true;
+    }
+  }
+  park_in_joints();  // the lift ended (reached or short)
+  return true;
+}
+
 void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
   if (m_.leaf != S::abort_lift && m_.leaf != S::abort_park) return;
   for (int s = 0; s < 2; ++s) {
     const ArmMotionStatus* a = in.arm[s];
-    if (joints_park_due(s, in) && spec_.park_lift_mm > 0) {  // up first, then in joint space
-      m_.park_joints[s] = Memory::kParkLifting;
-      m_.park_lift_mm[s] = spec_.park_lift_mm;
-      out.park_lift[s] = true;
-      arm_lift(s, m_.park_lift_mm[s], out);
-      continue;
-    }
-    const RetreatEnd lift_end = m_.park_joints[s] == Memory::kParkLifting
-                                    ? retreat_end(a, m_.arm_id[s])
-                                    : RetreatEnd::pending;
-    if (lift_end == RetreatEnd::gave_up && m_.park_lift_mm[s] * 0.5 >= Memory::kMinParkLiftMm) {
-      const auto why = static_cast<ArmMotionReason>(end_reason(*a, m_.arm_id[s]));
-      if (why == ArmMotionReason::unreachable ||
-          why == ArmMotionReason::joint_speed) {  // a shorter lift
-        m_.park_lift_mm[s] *= 0.5;
-        out.park_lift[s] = true;
-        arm_lift(s, m_.park_lift_mm[s], out);
-        continue;
-      }
-    }
-    const bool lifted = lift_end != RetreatEnd::pending;
-    if (lifted ||
-        joints_park_due(s, in)) {  // the lift ended (reached or short): the park, in joint space
-      m_.park_joints[s] = Memory::kParkJoints;
-      out.joints_park[s] = true;
-      arm_park(s, out, true);
-      continue;
-    }
-    if (m_.park_joints[s] == Memory::kParkLifting) continue;  // rising
+    if (park_out_of_reach(s, in, out)) continue;
     if (retreat_end(a, m_.arm_id[s]) != RetreatEnd::retry ||
         static_cast<double>(m_.last_ns - m_.arm_sent_ns[s]) * 1e-9 < kRetryS)
       continue;

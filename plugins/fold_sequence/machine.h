@@ -187,6 +187,9 @@ class Machine {
   // abort/park: role S's park, a straight line there, was refused as out of reach (unreachable,
   // joint_speed: a wrist the fold turned) and has not been sent in joint space yet (ArmGoal::joints).
   [[nodiscard]] bool joints_park_due(int s, const Sensing& in) const noexcept;
+  // abort/park, role S: a park out of reach on a line lifted by park_lift_mm (halved while out of
+  // reach), then sent in joint space. True when it took this cycle's turn of role S's retreat.
+  bool park_out_of_reach(int s, const Sensing& in, Outbox& out) noexcept;
   void arm_move(int side, std::uint8_t tool, std::uint8_t frame, const double p[3], const double q[4],
                 const MotionLimits& lim, std::uint8_t stop_fingers, Outbox& out) noexcept;  // 0: no stop
   // One motion through the n points of path_mm (1..ArmGoal::kMaxPoints), the tool turned to

@@ -458,6 +458,12 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
       if (x->arm_goal.kind == ArmGoal::move) g.push_back(&x->arm_goal);
     return g;
   };
+  // The fixing arm's park on a line, refused as out of reach (joints' parks and lifts taken).
+  const auto line_park_out_of_reach = [](int s, const ArmGoal& g, int) {
+    return s == kFix && g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian
+               ? ArmMotionReason::unreachable
+               : ArmMotionReason::none;
+  };
   SUBCASE("the lift aborts as arm_stale, the park is refused twice as arm_not_ready: both sent again") {
     Rig r;
     const long abort_at = start_and_run_to(r, "fold/shift/press");
@@ -491,10 +497,7 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
       "joint space, reached so") {
     Rig r;
     const long abort_at = start_and_run_to(r, "fold/shift/press");
-    r.refuse_as = [&](int s, const ArmGoal& g, int) {
-      return s == kFix && g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian ? ArmMotionReason::unreachable
-                                                                                            : ArmMotionReason::none;
-    };
+    r.refuse_as = line_park_out_of_reach;
     r.command(Command::abort);
     REQUIRE(r.run_to("aborted", 20000));
     const auto g = moves_after(r, abort_at);
@@ -526,13 +529,10 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
       "in joint space") {
     Rig r;
     const long abort_at = start_and_run_to(r, "fold/shift/press");
-    r.refuse_as = [&](int s, const ArmGoal& g, int) {
-      if (s != kFix) return ArmMotionReason::none;
-      if (g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian)
+    r.refuse_as = [&](int s, const ArmGoal& g, int c) {
+      if (s == kFix && g.frame == ArmGoal::measured && g.position_mm[0][2] > 100.0f)
         return ArmMotionReason::unreachable;
-      if (g.frame == ArmGoal::measured && g.position_mm[0][2] > 100.0f)
-        return ArmMotionReason::unreachable;
-      return ArmMotionReason::none;
+      return line_park_out_of_reach(s, g, c);
     };
     r.command(Command::abort);
     REQUIRE(r.run_to("aborted", 20000));
@@ -558,11 +558,7 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
     }
     Rig r((dir / "half.yaml").string());
     const long abort_at = start_and_run_to(r, "fold/shift/press");
-    r.refuse_as = [&](int s, const ArmGoal& g, int) {
-      return s == kFix && g.frame == ArmGoal::world && g.interpolation == ArmGoal::cartesian
-                 ? ArmMotionReason::unreachable
-                 : ArmMotionReason::none;
-    };
+    r.refuse_as = line_park_out_of_reach;
     r.command(Command::abort);
     REQUIRE(r.run_to("aborted", 20000));
     const auto g = moves_after(r, abort_at);
