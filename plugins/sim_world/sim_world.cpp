@@ -329,8 +329,7 @@ double World::geometric_penetration_mm() const noexcept {
 }
 
 bool World::over_table(Vec3 p) const noexcept {
-  const auto& e = params_.table_extent_mm;
-  return p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3];
+  return over_extent(p, params_.table_extent_mm.data());
 }
 
 void World::measure_penetration_rt() noexcept {

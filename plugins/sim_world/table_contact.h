@@ -11,6 +11,11 @@
 
 namespace crease::world {
 
+// Whether P lies over the table top's extent in x and y.
+[[nodiscard]] inline bool over_extent(Vec3 p, const double extent[4]) noexcept {
+  return p.x >= extent[0] && p.x <= extent[1] && p.y >= extent[2] && p.y <= extent[3];
+}
+
 struct TableContact {
   bool over = false;    // the shape's lowest point lies over the extent (else no contact at all)
   double depth_mm = 0;  // how far the shape is in, along `normal`; negative: the gap to the top
@@ -23,7 +28,7 @@ struct TableContact {
                                                 const double extent[4]) noexcept {
   TableContact c;
   const Vec3 low = lowest_point(g, pose);
-  c.over = low.x >= extent[0] && low.x <= extent[1] && low.y >= extent[2] && low.y <= extent[3];
+  c.over = over_extent(low, extent);
   if (!c.over) return c;
   c.depth_mm = top_mm - low.z;
   c.point = low;

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -134,6 +135,12 @@ class Creased {
   pid_t pid_ = -1;
   int status_ = 0;
 };
+
+// A count of an entry of a list reply (Creased::entry: a port's "writes", a loop's "cycles");
+// 0 when there is no such entry.
+inline std::uint64_t number(const nlohmann::json& entry, const char* key) {
+  return entry.is_null() ? 0 : entry[key].get<std::uint64_t>();
+}
 
 // The tracking error of a creased's summary: mean, model frames, last (mm).
 struct TrackingSummary {

@@ -25,10 +25,6 @@ bool eventually(P pred) {
   return false;
 }
 
-std::uint64_t number(const nlohmann::json& entry, const char* key) {
-  return entry.is_null() ? 0 : entry[key].get<std::uint64_t>();
-}
-
 // The per-second tracking errors the control daemon printed after its first FROM seconds.
 std::vector<double> seconds_after(const Creased& c, std::size_t from) {
   const std::vector<double> all = tracking_per_second(c.output());

@@ -37,8 +37,7 @@ TrackingSummary run_split(const TempDir& tmp, int truth_domain, const char* visi
                  {"--duration", vision_seconds, "--no-progress", "--set", "bridge.domain=" + d, "--set",
                   "truth.domain=" + std::to_string(truth_domain)});
   const auto writes = [&](const char* port) {
-    const nlohmann::json e = vision.entry("ports", port);
-    return e.is_null() ? std::uint64_t{0} : e["writes"].get<std::uint64_t>();
+    return number(vision.entry("ports", port), "writes");
   };
   for (int i = 0; i < 50 && writes("sheet_truth") == 0; ++i) std::this_thread::sleep_for(100ms);
   if (shapes_writes != nullptr) *shapes_writes = writes("world_shapes");
