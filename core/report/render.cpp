@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cinttypes>
+#include <cstdarg>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,20 +13,24 @@
 namespace crease::report {
 namespace {
 
-// printf into a std::string.
-template <typename... Args>
-void appendf(std::string& out, const char* fmt, Args... args) {
+// printf into a std::string (its format checked at each call).
+[[gnu::format(printf, 2, 3)]] void appendf(std::string& out, const char* fmt, ...) {
   char buf[512];
-  const int n = std::snprintf(buf, sizeof(buf), fmt, args...);
-  if (n <= 0) return;
-  if (static_cast<std::size_t>(n) < sizeof(buf)) {
+  std::va_list args;
+  va_start(args, fmt);
+  std::va_list again;
+  va_copy(again, args);
+  const int n = std::vsnprintf(buf, sizeof(buf), fmt, args);
+  va_end(args);
+  if (n > 0 && static_cast<std::size_t>(n) < sizeof(buf)) {
     out.append(buf, static_cast<std::size_t>(n));
-    return;
+  } else if (n > 0) {
+    std::string big(static_cast<std::size_t>(n) + 1, '\0');
+    std::vsnprintf(big.data(), big.size(), fmt, again);
+    big.pop_back();
+    out += big;
   }
-  std::string big(static_cast<std::size_t>(n) + 1, '\0');
-  std::snprintf(big.data(), big.size(), fmt, args...);
-  big.pop_back();
-  out += big;
+  va_end(again);
 }
 
 unsigned long us(std::int64_t ns) { return static_cast<unsigned long>(std::max<std::int64_t>(ns, 0) / 1000); }

@@ -33,7 +33,7 @@ bool finite_all(const World::HandJoints& a) {
 
 }  // namespace
 
-World::World(const robot::RobotModel& model, const WorldParams& params) : model_(model), params_(params) {
+World::World(const robot::RobotModel& model, const WorldParams& params) : params_(params) {
   require(params_.dt_s > 0 && params_.dt_s <= 0.1, "dt_s", "must be in (0, 0.1] s");
   require(params_.table_contact_area_mm2 > 0, "table_contact_area_mm2", "must be > 0");
   require(params_.initial_stiffness_nm_per_rad >= 0, "initial_stiffness_nm_per_rad", "must be >= 0");

@@ -124,7 +124,6 @@ class World {
   [[nodiscard]] bool over_table(Vec3 p) const noexcept;  // within the table top's extent in x, y
   void fill_state_rt() noexcept;
 
-  const robot::RobotModel& model_;
   WorldParams params_;
   WorldDraws draws_;
   std::unique_ptr<sheet::XpbdSheet> sheet_;

@@ -114,8 +114,10 @@ TEST_CASE("config/split: the folding sequence's edits cross from the control dae
     const auto it = p.ports.find(local);
     return it == p.ports.end() ? local : it->second;
   };
-  for (const auto& [fold_port, model_port] : {std::pair<std::string, std::string>{"sheet_crease", "crease"},
-                                              std::pair<std::string, std::string>{"sheet_memorize", "memorize"}}) {
+  for (const auto& pair : {std::pair<std::string, std::string>{"sheet_crease", "crease"},
+                           std::pair<std::string, std::string>{"sheet_memorize", "memorize"}}) {
+    const std::string& fold_port = pair.first;  // plain names: CAPTURE takes them into a lambda
+    const std::string& model_port = pair.second;
     CAPTURE(fold_port);
     const std::string written = global(*fold, fold_port);   // the fold's queue in control
     const std::string read = global(*sheet, model_port);     // the model's queue in vision

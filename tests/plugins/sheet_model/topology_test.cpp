@@ -52,6 +52,6 @@ TEST_CASE("the neighbourhood is configurable") {
 TEST_CASE("bad parameters name the key") {
   GridParams g;
   g.nodes_u = 1;
-  CHECK_THROWS_WITH_AS(build_topology(g, TopologyParams{}), doctest::Contains("grid.nodes_u"),
+  CHECK_THROWS_WITH_AS((void)build_topology(g, TopologyParams{}), doctest::Contains("grid.nodes_u"),
                        crease::ConfigError);
 }

@@ -47,7 +47,7 @@ inline KDL::Rotation frame_from_z_x(Vec3 z, Vec3 x_hint) {
 // Places a tool link of one side's hand at a pose by moving the arm only.
 class ArmIk {
  public:
-  ArmIk(const robot::RobotModel& m, robot::Side side) : side_(side) {
+  ArmIk(const robot::RobotModel& m, robot::Side side) {
     const std::string prefix = m.params().side(side).prefix;
     REQUIRE(m.tree().getChain("world", prefix + "flange", chain_));
     REQUIRE(chain_.getNrOfJoints() == robot::kArmJoints);
@@ -133,7 +133,6 @@ class ArmIk {
   }
 
  private:
-  robot::Side side_;
   KDL::Chain chain_;
   std::unique_ptr<KDL::ChainIkSolverPos_LMA> solver_;
   std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk_;

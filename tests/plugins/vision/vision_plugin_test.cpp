@@ -176,7 +176,9 @@ TEST_CASE("camera_replay -> vision twice: identical key-points, frame by frame")
   CHECK(a.rbegin()->first == 2);
   CHECK(b.rbegin()->first == 2);
   int compared = 0;
-  for (const auto& [frame, ka] : a) {
+  for (const auto& entry : a) {
+    const auto frame = entry.first;  // a plain variable: CAPTURE takes it into a lambda
+    const auto& ka = entry.second;
     const auto it = b.find(frame);
     if (it == b.end()) continue;
     const crease::Keypoints& kb = it->second;

@@ -153,8 +153,8 @@ TEST_CASE("a 40 N spike among 5000 samples survives the decimation to at most 20
   const auto ticks = force_ticks(html);
   REQUIRE(ticks.size() >= 2);
   CHECK(ticks.front().second == 0.0);
-  const auto [y0, v0] = ticks.front();
-  const auto [y1, v1] = ticks.back();
+  const double y0 = ticks.front().first, v0 = ticks.front().second;
+  const double y1 = ticks.back().first, v1 = ticks.back().second;
   const auto newtons = [&](double y) { return v0 + (y - y0) * (v1 - v0) / (y1 - y0); };
   double top_y = 1e9, spike_x = 0;
   for (const auto& [x, y] : right)

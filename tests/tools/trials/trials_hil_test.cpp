@@ -52,7 +52,9 @@ std::string read_all(const fs::path& file) {
 TEST_CASE("crease-trials: two short trials run, are scored from the world's truth as unfolded, and the hands end clear") {
   char tmpl[] = "/tmp/crease-trials-XXXXXX";
   const fs::path dir = mkdtemp(tmpl);
-  const auto [out, rc] = crease_trials("--trials 2 --seed 3 --max-fold-s 6 --retain-s 0", dir);
+  const Run run = crease_trials("--trials 2 --seed 3 --max-fold-s 6 --retain-s 0", dir);
+  const std::string& out = run.out;  // plain names: INFO and CHECK take them into lambdas
+  const int rc = run.rc;
   INFO(out);
   REQUIRE(WIFEXITED(rc));
   CHECK(WEXITSTATUS(rc) == 0);
@@ -128,7 +130,9 @@ TEST_CASE("crease-trials: two short trials run, are scored from the world's trut
 TEST_CASE("crease-trials --faults: the trial runs with the world's bus faults and the cameras' dropouts, drawn from its seed, and says so") {
   char tmpl[] = "/tmp/crease-trials-XXXXXX";
   const fs::path dir = mkdtemp(tmpl);
-  const auto [out, rc] = crease_trials("--trials 1 --seed 5 --faults --max-fold-s 4 --retain-s 0", dir);
+  const Run run = crease_trials("--trials 1 --seed 5 --faults --max-fold-s 4 --retain-s 0", dir);
+  const std::string& out = run.out;  // plain names: INFO and CHECK take them into lambdas
+  const int rc = run.rc;
   INFO(out);
   REQUIRE(WIFEXITED(rc));
   CHECK(WEXITSTATUS(rc) == 0);
