@@ -22,15 +22,19 @@ constexpr auto kSpace = [] {
   return t;
 }();
 bool is_space(char c) noexcept {
-  return kSpace[static_cast<unsigned char>(c)];
+  return kSpace.data()[static_cast<unsigned char>(c)];
 }
 
-// Next whitespace-separated token of s starting at *pos.
+// Next whitespace-separated token of s starting at *pos (a pointer scan: one bound check a
+// character, no substr).
 std::string_view token(std::string_view s, std::size_t* pos) noexcept {
-  while (*pos < s.size() && is_space(s[*pos])) ++*pos;
-  const std::size_t b = *pos;
-  while (*pos < s.size() && !is_space(s[*pos])) ++*pos;
-  return s.substr(b, *pos - b);
+  const char* p = s.data() + *pos;
+  const char* const end = s.data() + s.size();
+  while (p != end && is_space(*p)) ++p;
+  const char* const b = p;
+  while (p != end && !is_space(*p)) ++p;
+  *pos = static_cast<std::size_t>(p - s.data());
+  return {b, static_cast<std::size_t>(p - b)};
 }
 
 bool parse_hex(std::string_view t, std::uint32_t max_digits, std::uint32_t* out) noexcept {

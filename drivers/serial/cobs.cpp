@@ -33,6 +33,10 @@ std::size_t cobs_encode(std::span<const std::uint8_t> in, std::span<std::uint8_t
   }
 }
 
+// Blocks shorter than this are checked and copied byte by byte (frames of small values have
+// many), longer ones with memchr and memcpy.
+constexpr std::size_t kShortBlock = 16;
+
 long cobs_decode(std::span<const std::uint8_t> in, std::span<std::uint8_t> out) noexcept {
   const std::uint8_t* p = in.data();
   const std::uint8_t* const end = p + in.size();
@@ -46,12 +50,17 @@ long cobs_decode(std::span<const std::uint8_t> in, std::span<std::uint8_t> out) 
     const std::size_t k = static_cast<std::size_t>(code) - 1;
     if (k > static_cast<std::size_t>(end - p) || k > static_cast<std::size_t>(out_end - o))
       return -1;
-    if (k) {
+    if (k >= kShortBlock) {
       if (std::memchr(p, 0, k)) return -1;
       std::memcpy(o, p, k);
-      p += k;
-      o += k;
+    } else {
+      for (std::size_t i = 0; i < k; ++i) {  // a short block: two library calls cost more
+        if (p[i] == 0) return -1;
+        o[i] = p[i];
+      }
     }
+    p += k;
+    o += k;
     if (p != end && code != 0xFF) {
       if (o == out_end) return -1;
       *o++ = 0;
