@@ -11,8 +11,9 @@ bool sheet_frame_m(const SheetState& s, KDL::Frame& out) noexcept {
   const auto node = [&](unsigned i) {
     return KDL::Vector(s.position_mm[i][0], s.position_mm[i][1], s.position_mm[i][2]) / 1000.0;
   };
-  const unsigned mid = std::max(1u, (h - 1) / 2);  // node (0, mid): halfway along the v edge
-  const KDL::Vector o = node(0), u = node(w - 1), v = node(mid * w);
+  const unsigned quarter =
+      std::max(1u, (h - 1) / 4);  // node (0, quarter): a quarter along the v edge
+  const KDL::Vector o = node(0), u = node(w - 1), v = node(quarter * w);
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(o(i)) || !std::isfinite(u(i)) || !std::isfinite(v(i))) return false;
   KDL::Vector x = u - o;

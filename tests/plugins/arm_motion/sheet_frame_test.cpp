@@ -75,3 +75,37 @@ TEST_CASE("the frame stays with the sheet's base while its far half is folded up
   z.Normalize();
   CHECK(std::acos(KDL::dot(z, flat.M.UnitZ())) == doctest::Approx(std::numbers::pi / 4).epsilon(0.01));
 }
+
+TEST_CASE("the frame stays with the sheet's base when the fold lifts its crease into a loop") {
+  // The world's sheet on a 3 x 9 grid, flat; then the nodes on and next to the crease
+  // v = 148.5 raised into a loop (30 mm on the crease, 15 mm beside it), as a laid half fold
+  // leaves it. The frame is the flat one; from the node halfway along the v edge (on the
+  // crease) it would tilt by atan(30 / 148.5), 11 deg.
+  auto s = std::make_unique<SheetState>();
+  s->nodes_u = 3;
+  s->nodes_v = 9;
+  auto lay = [&](bool loop) {
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 3; ++i) {
+        float* p = s->position_mm[j * 3 + i];
+        p[0] = static_cast<float>(-105.0 + 105.0 * i);
+        p[1] = static_cast<float>(148.5 - 37.125 * j);
+        p[2] = static_cast<float>(0.1 +
+                                  (loop ? (j == 4 ? 30.0 : (j == 3 || j == 5 ? 15.0 : 0.0)) : 0.0));
+      }
+  };
+  lay(false);
+  KDL::Frame flat, looped;
+  REQUIRE(sheet_frame_m(*s, flat));
+  lay(true);
+  REQUIRE(sheet_frame_m(*s, looped));
+  CHECK(norm(looped.p - flat.p) < 1e-9);
+  CHECK(norm(looped.M.UnitZ() - flat.M.UnitZ()) < 1e-6);
+  // What the crease node would have given.
+  const KDL::Vector o(s->position_mm[0][0], s->position_mm[0][1], s->position_mm[0][2]);
+  const KDL::Vector c(s->position_mm[12][0], s->position_mm[12][1], s->position_mm[12][2]);
+  KDL::Vector z = KDL::Vector(1, 0, 0) * (c - o);
+  z.Normalize();
+  CHECK(std::acos(KDL::dot(z, flat.M.UnitZ())) ==
+        doctest::Approx(std::atan(30.0 / 148.5)).epsilon(0.01));
+}
