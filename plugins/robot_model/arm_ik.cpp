@@ -2,7 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -33,6 +33,7 @@ ArmIk::ArmIk(const RobotModel& model, Side side, const Options& options) : opt_(
     }
   }
   fk_ = std::make_unique<KDL::ChainFkSolverPos_recursive>(*chain_);
+  rt_chain_ = std::make_unique<ArmChainRt>(*chain_);
   q_.resize(kArmJoints);
   tools_.reserve(kToolFrames);
   for (int f = 0; f < kToolFrames; ++f) {
@@ -64,28 +65,25 @@ KDL::Frame ArmIk::tool_pose(std::span<const double, kArmJoints> q) noexcept {
 }
 
 void ArmIk::pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept {
-  // One pass down the chain: each joint's axis and origin in the world before its own motion,
-  // then the flange; column j = [a_j x (p_tool - o_j); a_j] (the geometric Jacobian at the
-  // tool frame's origin, what KDL's ChainJntToJacSolver with changeRefPoint gives).
-  KDL::Vector axis[kArmJoints], origin[kArmJoints];
-  KDL::Frame t = KDL::Frame::Identity();
-  int j = 0;
-  for (const KDL::Segment& seg : chain_->segments) {
-    const KDL::Joint& joint = seg.getJoint();
-    if (joint.getType() == KDL::Joint::None) {
-      t = t * seg.pose(0.0);
-      continue;
-    }
-    axis[j] = t.M * joint.JointAxis();
-    origin[j] = t * joint.JointOrigin();
-    t = t * seg.pose(q_(j));
-    ++j;
-  }
-  f_ = t;
-  const KDL::Vector p_tool = t * flange_tool_.p;
+  // One pass down the chain (ArmChainRt): each joint's axis and origin in the world before its
+  // own motion, then the flange; column j = [a_j x (p_tool - o_j); a_j] (the geometric Jacobian
+  // at the tool frame's origin, what KDL's ChainJntToJacSolver with changeRefPoint gives).
+  std::array<double, kArmJoints> q;
+  for (int j = 0; j < kArmJoints; ++j) q[static_cast<std::size_t>(j)] = q_(j);
+  std::array<Eigen::Vector3d, kArmJoints> axis, origin;
+  Eigen::Isometry3d flange;
+  rt_chain_->pass(q, axis, origin, flange);
+  const Eigen::Matrix3d& r = flange.linear();
+  const Eigen::Vector3d& p = flange.translation();
+  f_ = KDL::Frame(KDL::Rotation(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0),
+                                r(2, 1), r(2, 2)),
+                  KDL::Vector(p.x(), p.y(), p.z()));
+  const Eigen::Vector3d p_tool =
+      flange * Eigen::Vector3d(flange_tool_.p.x(), flange_tool_.p.y(), flange_tool_.p.z());
   for (int k = 0; k < kArmJoints; ++k) {
-    const KDL::Vector v = axis[k] * (p_tool - origin[k]);
-    J.col(k) << v.x(), v.y(), v.z(), axis[k].x(), axis[k].y(), axis[k].z();
+    const auto& a = axis[static_cast<std::size_t>(k)];
+    J.col(k).head<3>() = a.cross(p_tool - origin[static_cast<std::size_t>(k)]);
+    J.col(k).tail<3>() = a;
   }
 }
 

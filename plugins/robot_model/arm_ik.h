@@ -1,9 +1,10 @@
 // Inverse kinematics of one 7-DOF arm to a tool frame's pose, the hand's angles held fixed.
 //
 //   ArmIk ik(model, Side::right, ArmIk::Options{});          // configure time: allocates
-//   ik.set_tool(ToolFrame::ff_pad, arm_q, hand_q);            // RT: flange -> tool, this hand posture
-//   ArmIk::Result r = ik.solve(target_world_m, seed_q, q);    // RT: from a seed, with restarts
-//   r = ik.track(next_target_m, q);                            // RT: warm-started, a few iterations
+//   ik.set_tool(ToolFrame::ff_pad, arm_q, hand_q);            // RT: flange -> tool, this hand
+//   posture ArmIk::Result r = ik.solve(target_world_m, seed_q, q);    // RT: from a seed, with
+//   restarts r = ik.track(next_target_m, q);                            // RT: warm-started, a few
+//   iterations
 //
 // The tool's pose is the flange's times a fixed flange -> tool offset, taken from the hand's
 // angles by set_tool (so the arm alone positions the tool frame; a finger that moves later
@@ -13,35 +14,34 @@
 //
 // e the tool frame's pose error (position m; rotation 1/2 sum r_i x r_target_i = sin(theta) axis,
 // exact at small angles), J the 6x7 geometric Jacobian at the tool frame's origin (one pass down
-// the chain, the pose with it; equal to KDL's ChainJntToJacSolver), lambda^2 = lambda0^2 + c |e|^2 (damped least
-// squares, Levenberg-Marquardt style: robust far from the target, quadratic near it, bounded at
-// singularities); the second term is the stated redundancy resolution: in the Jacobian's null
-// space, towards a rest posture (by default elbow bent, wrist bent: the posture the arms work
-// over the table in), applied once per call (k = rest_gain in solve, track_rest_gain in track)
-// so it moves the elbow slowly and never the tool.
-// Joint limits: each step is clamped to [lower, upper] (the URDF's), and a joint that reached
-// a limit is locked (its Jacobian column zeroed) for the rest of the call, so the others
-// complete the task; every returned q lies within the limits. solve() restarts from
-// deterministic pseudo-random seeds within the limits when an attempt stalls.
+// the chain (arm_chain_rt.h), the pose with it; equal to KDL's ChainJntToJacSolver), lambda^2 =
+// lambda0^2 + c |e|^2 (damped least squares, Levenberg-Marquardt style: robust far from the target,
+// quadratic near it, bounded at singularities); the second term is the stated redundancy
+// resolution: in the Jacobian's null space, towards a rest posture (by default elbow bent, wrist
+// bent: the posture the arms work over the table in), applied once per call (k = rest_gain in
+// solve, track_rest_gain in track) so it moves the elbow slowly and never the tool. Joint limits:
+// each step is clamped to [lower, upper] (the URDF's), and a joint that reached a limit is locked
+// (its Jacobian column zeroed) for the rest of the call, so the others complete the task; every
+// returned q lies within the limits. solve() restarts from deterministic pseudo-random seeds within
+// the limits when an attempt stalls.
 //
 // All buffers are fixed-size (Eigen fixed matrices, KDL arrays sized at construction): solve,
 // track and set_tool allocate nothing, lock nothing, never throw. Not for concurrent calls.
 // Metres and radians (KDL's units).
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/frames.hpp>
-
-#include <Eigen/Core>
 #include <kdl/jntarray.hpp>
-
-#include <array>
-#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
 
+#include "plugins/robot_model/arm_chain_rt.h"
 #include "plugins/robot_model/robot_model.h"
 
 namespace crease::robot {
@@ -124,6 +124,7 @@ class ArmIk {
   Options opt_;
   std::unique_ptr<KDL::Chain> chain_;  // heap: the solvers keep references to it
   std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk_;
+  std::unique_ptr<ArmChainRt> rt_chain_;  // the same chain for the iterations' passes
   std::vector<ToolChain> tools_;       // world -> each tool frame, for set_tool
   std::unique_ptr<ToolChain> flange_chain_;
   KDL::JntArray q_;
