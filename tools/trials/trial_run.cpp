@@ -186,6 +186,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
       host.set_param(fold, "command", 1.0);  // creasectl sequence start: taken when the guard passes
       std::int64_t started_ns = 0, ended_ns = 0, sampled_ns = 0;
       double window_force[2] = {0, 0};  // each hand's largest fingertip force since the last sample
+      int window_tip[2] = {-1, -1};     // ... which fingertip, and its height then
+      double window_tip_z[2] = {std::nan(""), std::nan("")};
       double window_measured[2] = {std::nan(""), std::nan("")};  // ... as its force controller measured it
       std::uint32_t seen_transitions = 0;
       std::set<std::string> fold_states;
@@ -201,8 +203,15 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
         const SequenceStatus& s = status->value();
         if (world_state->poll().has_data()) {
           for (int h = 0; h < 2; ++h)
-            for (const WorldFingertip& t : world_state->value().hand[h].tip)
-              window_force[h] = std::max(window_force[h], double(t.normal_force_n));
+            for (int f = 0; f < static_cast<int>(std::size(world_state->value().hand[h].tip));
+                 ++f) {
+              const WorldFingertip& t = world_state->value().hand[h].tip[f];
+              if (t.normal_force_n > 0 && double(t.normal_force_n) > window_force[h]) {
+                window_force[h] = t.normal_force_n;
+                window_tip[h] = f;
+                window_tip_z[h] = t.position_mm[2];
+              }
+            }
           for (int h = 0; h < 2; ++h) r.max_force_n[h] = std::max(r.max_force_n[h], window_force[h]);
         }
         for (int h = 0; h < 2; ++h)
@@ -212,9 +221,15 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
         if (started_ns != 0 && rt::now_ns() - sampled_ns >= static_cast<std::int64_t>(kSeriesS * 1e9)) {
           sampled_ns = rt::now_ns();
           const double stretch = truth->poll().has_data() ? max_stretch(truth->value()) : std::nan("");
-          r.series.push_back({since(started_ns), {window_force[0], window_force[1]}, stretch,
-                              {window_measured[0], window_measured[1]}});
+          r.series.push_back({since(started_ns),
+                              {window_force[0], window_force[1]},
+                              stretch,
+                              {window_measured[0], window_measured[1]},
+                              {window_tip[0], window_tip[1]},
+                              {window_tip_z[0], window_tip_z[1]}});
           window_force[0] = window_force[1] = 0;
+          window_tip[0] = window_tip[1] = -1;
+          window_tip_z[0] = window_tip_z[1] = std::nan("");
           window_measured[0] = window_measured[1] = std::nan("");
         }
         if (started_ns == 0 && s.phase != SequenceStatus::idle) {
@@ -346,9 +361,12 @@ double num(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : s
 nlohmann::json to_json(const TrialResult& r) {
   nlohmann::json timeline = nlohmann::json::array();
   for (const auto& e : r.timeline) timeline.push_back({{"t_s", e.t_s}, {"path", e.path}, {"why", e.why}});
-  nlohmann::json series = {{"t_s", nlohmann::json::array()}, {"force_r_n", nlohmann::json::array()},
-                           {"force_l_n", nlohmann::json::array()}, {"stretch", nlohmann::json::array()},
-                           {"measured_r_n", nlohmann::json::array()}, {"measured_l_n", nlohmann::json::array()}};
+  nlohmann::json series = {
+      {"t_s", nlohmann::json::array()},          {"force_r_n", nlohmann::json::array()},
+      {"force_l_n", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
+      {"measured_r_n", nlohmann::json::array()}, {"measured_l_n", nlohmann::json::array()},
+      {"tip_r", nlohmann::json::array()},        {"tip_l", nlohmann::json::array()},
+      {"tip_r_z_mm", nlohmann::json::array()},   {"tip_l_z_mm", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -360,6 +378,10 @@ nlohmann::json to_json(const TrialResult& r) {
     series["stretch"].push_back(num(x.stretch));
     series["measured_r_n"].push_back(num(x.measured_n[0]));
     series["measured_l_n"].push_back(num(x.measured_n[1]));
+    series["tip_r"].push_back(x.force_tip[0]);
+    series["tip_l"].push_back(x.force_tip[1]);
+    series["tip_r_z_mm"].push_back(num(x.force_tip_z_mm[0]));
+    series["tip_l_z_mm"].push_back(num(x.force_tip_z_mm[1]));
   }
   const Score& s = r.score;
   return {{"trial", r.index},
@@ -445,6 +467,12 @@ TrialResult from_json(const nlohmann::json& j) {
                      num(x.at("stretch")[k])};
       if (x.contains("measured_r_n")) v.measured_n[0] = num(x.at("measured_r_n")[k]);
       if (x.contains("measured_l_n")) v.measured_n[1] = num(x.at("measured_l_n")[k]);
+      if (x.contains("tip_r")) {
+        v.force_tip[0] = x.at("tip_r")[k].get<int>();
+        v.force_tip[1] = x.at("tip_l")[k].get<int>();
+        v.force_tip_z_mm[0] = num(x.at("tip_r_z_mm")[k]);
+        v.force_tip_z_mm[1] = num(x.at("tip_l_z_mm")[k]);
+      }
       r.series.push_back(v);
     }
   }

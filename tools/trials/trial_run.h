@@ -53,6 +53,11 @@ struct SeriesSample {
   // sensors, hand_control_status) since the last sample, N; NaN without one. Beside force_n:
   // the sensors' estimate against the world's truth.
   double measured_n[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  // Which fingertip of each hand carried force_n (0 ff, 1 mf, 2 rf, 3 lf, 4 th; -1: none
+  // pressed) and its height over the table then (mm): where a force limit comes from.
+  int force_tip[2] = {-1, -1};
+  double force_tip_z_mm[2] = {std::numeric_limits<double>::quiet_NaN(),
+                              std::numeric_limits<double>::quiet_NaN()};
 };
 inline constexpr double kSeriesS = 0.02;
 
