@@ -104,13 +104,7 @@ int run_depth(int argc, char** argv) {
   double t_now = 0.0;
   const auto mesh_at = [&](std::uint64_t) {
     script.node_positions(std::max(0.0, t_now - start_s), truth);
-    vision::SheetMesh m;
-    m.nx = W;
-    m.ny = H;
-    m.w_mm = sp.grid.width_mm;
-    m.h_mm = sp.grid.height_mm;
-    for (const auto& p : truth) m.nodes.emplace_back(p.x, p.y, p.z);
-    return m;
+    return bench::mesh_of(sp, truth);
   };
   const cv::Mat tex = vision::DepthSimSource::plain_texture(400, 400, 1.0);
   vision::RenderOptions ro;
@@ -152,12 +146,7 @@ int run_depth(int argc, char** argv) {
   for (int i = 0; i < frames; ++i) {
     t_now = i / 30.0;
     if (!creased && t_now >= start_s) {  // the sequence announces the crease as the fold starts
-      SheetCreaseEvent e;
-      e.a_mm[0] = 0.0f;
-      e.a_mm[1] = float(0.5 * sp.grid.height_mm);
-      e.b_mm[0] = float(sp.grid.width_mm);
-      e.b_mm[1] = float(0.5 * sp.grid.height_mm);
-      runner.apply(e);
+      runner.apply(bench::half_fold_crease(sp));
       creased = true;
     }
     (void)source.grab(f);

@@ -22,6 +22,35 @@
 
 namespace crease::bench {
 
+vision::SheetMesh mesh_of(const sheet::SheetParams& sp, const std::vector<sheet::Vec3>& nodes) {
+  vision::SheetMesh m;
+  m.nx = sp.grid.nodes_u;
+  m.ny = sp.grid.nodes_v;
+  m.w_mm = sp.grid.width_mm;
+  m.h_mm = sp.grid.height_mm;
+  for (const auto& p : nodes) m.nodes.emplace_back(p.x, p.y, p.z);
+  return m;
+}
+
+SheetCreaseEvent half_fold_crease(const sheet::SheetParams& sp) {
+  SheetCreaseEvent e;
+  e.a_mm[0] = 0.0f;
+  e.a_mm[1] = float(0.5 * sp.grid.height_mm);
+  e.b_mm[0] = float(sp.grid.width_mm);
+  e.b_mm[1] = float(0.5 * sp.grid.height_mm);
+  return e;
+}
+
+double mean_error_mm(const SheetState& s, const std::vector<sheet::Vec3>& truth) {
+  double e = 0;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    const auto& p = truth[k];
+    e +=
+        std::hypot(s.position_mm[k][0] - p.x, s.position_mm[k][1] - p.y, s.position_mm[k][2] - p.z);
+  }
+  return truth.empty() ? 0.0 : e / static_cast<double>(truth.size());
+}
+
 TrackingError track_printed_sheet(const FusedSetup& s, bool use_depth, bool use_markers) {
   const std::string src = CREASE_SOURCE_DIR;
   const vision::MarkerLayout layout = vision::load_layout(src + "/config/markers/layout.yaml");
@@ -34,18 +63,11 @@ TrackingError track_printed_sheet(const FusedSetup& s, bool use_depth, bool use_
                                    vision::TriangulationConfig{});
 
   const sheet::SheetParams& sp = s.sheet;
-  const int W = sp.grid.nodes_u, H = sp.grid.nodes_v, M = W * H;
-  std::vector<sheet::Vec3> truth(static_cast<std::size_t>(M));
+  std::vector<sheet::Vec3> truth(static_cast<std::size_t>(sp.grid.nodes_u * sp.grid.nodes_v));
   double t_now = 0.0;
   const auto mesh_now = [&] {
     s.script->node_positions(std::max(0.0, t_now - s.start_s), truth);
-    vision::SheetMesh m;
-    m.nx = W;
-    m.ny = H;
-    m.w_mm = sp.grid.width_mm;
-    m.h_mm = sp.grid.height_mm;
-    for (const auto& p : truth) m.nodes.emplace_back(p.x, p.y, p.z);
-    return m;
+    return mesh_of(sp, truth);
   };
   vision::RenderOptions ro;
   ro.noise_sigma = 1.0;
@@ -78,12 +100,7 @@ TrackingError track_printed_sheet(const FusedSetup& s, bool use_depth, bool use_
   for (int i = 0; i < frames; ++i) {
     t_now = i / 30.0;
     if (!creased && t_now >= s.start_s) {
-      SheetCreaseEvent e;
-      e.a_mm[0] = 0.0f;
-      e.a_mm[1] = float(0.5 * sp.grid.height_mm);
-      e.b_mm[0] = float(sp.grid.width_mm);
-      e.b_mm[1] = float(0.5 * sp.grid.height_mm);
-      runner.apply(e);
+      runner.apply(half_fold_crease(sp));
       creased = true;
     }
     if (use_depth) {
@@ -115,13 +132,7 @@ TrackingError track_printed_sheet(const FusedSetup& s, bool use_depth, bool use_
     }
     if (t_now >= s.start_s) {
       s.script->node_positions(std::max(0.0, t_now + 1.0 / 30 - s.start_s), truth);
-      double e = 0;
-      for (int k = 0; k < M; ++k) {
-        const auto& p = truth[static_cast<std::size_t>(k)];
-        e += std::hypot(state->position_mm[k][0] - p.x, state->position_mm[k][1] - p.y,
-                        state->position_mm[k][2] - p.z);
-      }
-      err.push_back(e / M);
+      err.push_back(mean_error_mm(*state, truth));
     }
   }
   for (double e : err) r.mean_mm += e / static_cast<double>(err.size());

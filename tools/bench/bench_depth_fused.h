@@ -5,9 +5,11 @@
 
 #include <vector>
 
+#include "core/port_types/sheet_state.h"
 #include "plugins/depth_tracking/depth_tracker.h"
 #include "plugins/sheet_model/sheet_params.h"
 #include "plugins/sim_world/scene/fold_script.h"
+#include "plugins/sim_world/scene/sheet_mesh.h"
 
 namespace crease::bench {
 
@@ -17,6 +19,13 @@ struct TrackingError {
   int keypoint_sets = 0;      // marker frames observed (15 Hz)
   double keypoints_mean = 0;  // triangulated key-points per marker frame
 };
+
+// Both parts' pieces: the truth's nodes as the renderers' mesh, the half fold's crease as the
+// sequence announces it, and the model's mean node distance to the truth (mm).
+[[nodiscard]] vision::SheetMesh mesh_of(const sheet::SheetParams& sp,
+                                        const std::vector<sheet::Vec3>& nodes);
+[[nodiscard]] SheetCreaseEvent half_fold_crease(const sheet::SheetParams& sp);
+[[nodiscard]] double mean_error_mm(const SheetState& s, const std::vector<sheet::Vec3>& truth);
 
 struct FusedSetup {
   sheet::SheetParams sheet;  // the model (origin, springs) as the depth-only part
