@@ -6,7 +6,8 @@
 // except through core).
 //
 // Common parameters (paths relative to the configuration file's folder, Params::get_path):
-//   record: DIR          write every grabbed frame in the replay layout
+//   record: DIR          write every grabbed frame in the replay layout (an RGB-D source's:
+//                        16-bit depth and colour PNGs, camera_source.h)
 //   lockstep: bool       grab the next frame only once the reader finished the last one
 //                        (default true: capture and detection take turns, as one thread did
 //                        before the split, so the newest frame is grabbed when detection can
@@ -24,6 +25,7 @@
 
 #include "core/plugin.h"
 #include "core/port_types/camera_frames.h"
+#include "plugins/camera_rig/depth_camera.h"
 #include "plugins/camera_rig/images_port.h"
 #include "plugins/cameras/camera_worker.h"
 
@@ -80,9 +82,12 @@ class CameraPlugin : public crease::Plugin {
     lockstep_ = p.get<bool>("lockstep", lockstep_default);
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
     const std::string record = p.has("record") ? p.get_path("record") : std::string();
-    // The replay layout has one grey image per camera: a source with other images cannot record.
-    if (!record.empty() && source->channel_images() != channel_specs(source->cameras()))
-      p.fail("record", "this source's images (depth and colour) have no replay layout yet");
+    // The replay layouts: one grey image per camera, or an RGB-D camera's depth and colour.
+    const bool grey = source->channel_images() == channel_specs(source->cameras());
+    const bool depth = source->channel_images() == depth_channel_specs(source->cameras()) &&
+                       source->depth_units_mm().size() == source->cameras().size();
+    if (!record.empty() && !grey && !depth)
+      p.fail("record", "this source's images have no replay layout");
     channel_ = bind_image_specs(ports, images_port, source->channel_images(), ImagesEnd::writer);
     std::memcpy(announce_.channel, channel_->name().c_str(), channel_->name().size() + 1);
     announce_.cameras = static_cast<std::uint32_t>(source->cameras().size());

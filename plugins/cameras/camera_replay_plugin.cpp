@@ -2,12 +2,15 @@
 // frame channel at its recorded rate, one frame per request; in lockstep with its reader (the
 // default), so every recorded frame is detected, in order, and the same recording gives the same
 // key-points every time. Frames are decoded ahead (`read_ahead` frame sets) on `decode_threads`
-// threads of the source's own, and stamped with the replay's time: the first frame with the time the plugin
-// started playing (its first update's request, CLOCK_MONOTONIC), the others their recorded
-// interval after it, so a recording made at any earlier time reaches the model as fresh (a late
-// frame moves the start: replay_source.h).
-// Parameters: replay_dir: DIR (its camK.yaml are the cameras), read_ahead (1..64, default 4),
-// decode_threads (1..16, default 2), and camera_plugin.h's.
+// threads of the source's own, and stamped with the replay's time: the first frame with the time
+// the plugin started playing (its first update's request, CLOCK_MONOTONIC), the others their
+// recorded interval after it, so a recording made at any earlier time reaches the model as fresh (a
+// late frame moves the start: replay_source.h). Parameters: replay_dir: DIR (its camK.yaml are the
+// cameras), read_ahead (1..64, default 4), decode_threads (1..16, default 2), and
+// camera_plugin.h's. Built twice: `camera_replay` plays a grey recording into `images` / `frames`;
+// `camera_depth_replay` (CREASE_DEPTH_REPLAY) a depth recording (camera_source.h: 16-bit depth
+// and colour PNGs, depth_unit_mm in the calibrations) into `depth_images` / `depth_frames`, as
+// camera_depth_sim publishes them. Each refuses the other's recording (a configure error).
 // Outputs: frames (crease::CameraFrames); replay_lag (Figure: how far behind its recorded time
 // each frame was handed out, ms; 0 when on time) and replay_late (Figure: the share of frames
 // played late, i.e. at or after the next frame was due, %: 100 per late frame, 0 per frame on
@@ -36,7 +39,18 @@ class CameraReplayPlugin final : public CameraPlugin {
     lag_out_ = ports.latest_output<crease::Figure>("replay_lag", lag_);
     late_out_ = ports.latest_output<crease::Figure>("replay_late", late_);
     seen_played_ = seen_late_ = 0;
+    const bool depth = !src->depth_units_mm().empty();
+#if defined(CREASE_DEPTH_REPLAY)
+    if (!depth)
+      p.fail("replay_dir",
+             "a recording of grey cameras (no depth_unit_mm in cam0.yaml): use camera_replay");
+    configure_camera(p, ports, std::move(src), true, kDepthImagesPort, kDepthFramesPort);
+#else
+    if (depth)
+      p.fail("replay_dir",
+             "a depth recording (depth_unit_mm in cam0.yaml): use camera_depth_replay");
     configure_camera(p, ports, std::move(src));
+#endif
   }
 
   crease::Status update(const crease::Cycle& cycle) override {
@@ -91,4 +105,8 @@ class CameraReplayPlugin final : public CameraPlugin {
 
 }  // namespace
 
+#if defined(CREASE_DEPTH_REPLAY)
+CREASE_PLUGIN(CameraReplayPlugin, "camera_depth_replay", "1.0.0")
+#else
 CREASE_PLUGIN(CameraReplayPlugin, "camera_replay", "1.1.0")
+#endif

@@ -4,11 +4,12 @@
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/assert.h"
+#include "core/errors.h"
+#include "plugins/camera_rig/depth_camera.h"
 #include "rt/clock.h"
 
 namespace crease::vision {
@@ -16,6 +17,12 @@ namespace crease::vision {
 std::string replay_frame_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
   char name[64];
   std::snprintf(name, sizeof name, "/cam%zu/%06" PRIu64 ".png", cam, index);
+  return dir + name;
+}
+
+std::string replay_colour_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
+  char name[64];
+  std::snprintf(name, sizeof name, "/cam%zu/%06" PRIu64 ".colour.png", cam, index);
   return dir + name;
 }
 
@@ -130,11 +137,20 @@ bool V4l2Source::grab(Frame& frame) {
   return true;  // live cameras do not end; a dark one delivers empty images until it is back
 }
 
-Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras) : dir_(dir), ncam_(cameras.size()) {
+Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras,
+                   const std::vector<double>& depth_units_mm)
+    : dir_(dir), ncam_(cameras.size()), depth_(!depth_units_mm.empty()) {
+  if (depth_ && depth_units_mm.size() != cameras.size())
+    throw crease::Error(dir + ": " + std::to_string(depth_units_mm.size()) + " depth units for " +
+                        std::to_string(cameras.size()) + " cameras");
   std::filesystem::create_directories(dir);
   for (std::size_t k = 0; k < cameras.size(); ++k) {
     std::filesystem::create_directories(dir + "/cam" + std::to_string(k));
-    save_camera(cameras[k], dir + "/cam" + std::to_string(k) + ".yaml");
+    const std::string yaml = dir + "/cam" + std::to_string(k) + ".yaml";
+    if (depth_)
+      save_depth_camera(DepthCamera{cameras[k], depth_units_mm[k]}, yaml);
+    else
+      save_camera(cameras[k], yaml);
   }
   const std::string csv = dir + "/timestamps.csv";
   stamps_ = std::fopen(csv.c_str(), "w");
@@ -147,11 +163,16 @@ Recorder::~Recorder() {
 }
 
 void Recorder::write(const Frame& frame) {
-  for (std::size_t k = 0; k < ncam_ && k < frame.images.size(); ++k) {
-    if (frame.images[k].empty()) continue;
-    const std::string p = replay_frame_path(dir_, k, frame.index);
-    if (!cv::imwrite(p, frame.images[k])) throw crease::Error(p + ": write failed");
-  }
+  // Grey: image k is camera k's; depth: images 2k (depth) and 2k + 1 (colour) are camera k's.
+  const std::size_t per = depth_ ? 2 : 1;
+  for (std::size_t k = 0; k < ncam_; ++k)
+    for (std::size_t i = 0; i < per && per * k + i < frame.images.size(); ++i) {
+      const cv::Mat& m = frame.images[per * k + i];
+      if (m.empty()) continue;
+      const std::string p = i == 0 ? replay_frame_path(dir_, k, frame.index)
+                                   : replay_colour_path(dir_, k, frame.index);
+      if (!cv::imwrite(p, m)) throw crease::Error(p + ": write failed");
+    }
   std::fprintf(stamps_, "%" PRIu64 ",%" PRId64 "\n", frame.index, frame.timestamp_ns);
   std::fflush(stamps_);
 }

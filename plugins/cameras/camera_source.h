@@ -4,6 +4,10 @@
 //   DIR/camK.yaml            calibration of camera K (plugins/camera_rig/camera_model.h format)
 //   DIR/camK/NNNNNN.png      frame NNNNNN of camera K (8-bit grey)
 //   DIR/timestamps.csv       "frame,timestamp_ns" header, one line per frame (integer ns)
+// and of an RGB-D source (plugins/camera_rig/depth_camera.h) the same, with:
+//   DIR/camK.yaml            its calibration with `depth_unit_mm` (what marks a depth recording)
+//   DIR/camK/NNNNNN.png      its depth (16-bit PNG, counts of depth_unit_mm, 0 = no depth)
+//   DIR/camK/NNNNNN.colour.png  its registered colour image (8-bit BGR)
 // A camera that delivers nothing this frame leaves its image empty; the others go on.
 // Not RT code (file and device I/O, OpenCV allocation): run it on a vision worker thread.
 #pragma once
@@ -43,6 +47,8 @@ class CameraSource {
   [[nodiscard]] virtual std::vector<crease::frames::CameraSpec> channel_images() const {
     return channel_specs(cameras());
   }
+  // An RGB-D source's depth unit per camera (mm per count); empty for grey cameras.
+  [[nodiscard]] virtual std::vector<double> depth_units_mm() const { return {}; }
   // Fills the next frame; false at the end of a recording (or when no camera delivers).
   virtual bool grab(Frame& frame) = 0;
   // Any thread: asks a grab() that waits (a replay pacing its frames) to return soon, and every
@@ -52,6 +58,9 @@ class CameraSource {
 
 // DIR/camK/NNNNNN.png: where the replay layout keeps frame `index` of camera `cam`.
 [[nodiscard]] std::string replay_frame_path(const std::string& dir, std::size_t cam, std::uint64_t index);
+// DIR/camK/NNNNNN.colour.png: the colour image of a depth recording's frame.
+[[nodiscard]] std::string replay_colour_path(const std::string& dir, std::size_t cam,
+                                             std::uint64_t index);
 
 // How a live camera that did not open, or stopped delivering, is brought back: the capture
 // worker (inside grab()) retries opening it `initial_s` after the failure, doubling the wait
@@ -116,12 +125,15 @@ class V4l2Source final : public CameraSource {
 // Writes frames in the replay layout (the `record` option of every source).
 class Recorder {
  public:
-  Recorder(const std::string& dir, const std::vector<Camera>& cameras);
+  // depth_units_mm empty: grey cameras; else one per camera: an RGB-D source's layout.
+  Recorder(const std::string& dir, const std::vector<Camera>& cameras,
+           const std::vector<double>& depth_units_mm = {});
   void write(const Frame& frame);
 
  private:
   std::string dir_;
   std::size_t ncam_;
+  bool depth_ = false;
   std::FILE* stamps_ = nullptr;
 
  public:

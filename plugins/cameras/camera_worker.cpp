@@ -28,7 +28,9 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
   // registry checked them.
   CREASE_DEMAND(channel_->cameras() == source_->channel_images(),
                 "the frame channel does not have this source's cameras");
-  if (!record_dir.empty()) recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras());
+  if (!record_dir.empty())
+    recorder_ =
+        std::make_unique<Recorder>(record_dir, source_->cameras(), source_->depth_units_mm());
   writer_ = channel_->try_claim_writer();  // now if free, so the first request need not wait
   thread_ = std::thread([this] { run(); });
 }

@@ -5,11 +5,12 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <opencv2/core/persistence.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "core/assert.h"
+#include "plugins/camera_rig/depth_camera.h"
 
 namespace crease::vision {
 
@@ -74,7 +75,23 @@ std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::
 }
 
 ReplayReader::ReplayReader(const std::string& dir) : dir_(dir) {
-  cameras_ = load_camera_dir(dir);
+  // A depth recording's calibrations carry depth_unit_mm (camera_source.h's layout).
+  bool depth = false;
+  {
+    cv::FileStorage fs;
+    try {
+      fs.open(dir + "/cam0.yaml", cv::FileStorage::READ);
+    } catch (const cv::Exception&) {
+    }
+    depth = fs.isOpened() && !fs["depth_unit_mm"].empty();
+  }
+  if (depth) {
+    const std::vector<DepthCamera> cams = load_depth_camera_dir(dir);
+    cameras_ = cameras_of(cams);
+    for (const DepthCamera& c : cams) depth_units_mm_.push_back(c.depth_unit_mm);
+  } else {
+    cameras_ = load_camera_dir(dir);
+  }
   const std::string csv = dir + "/timestamps.csv";
   std::ifstream in(csv);
   crease::require_input(static_cast<bool>(in), csv + ": cannot read");
@@ -88,13 +105,24 @@ void ReplayReader::read(std::size_t i, Frame& frame) const {
   const RecordedStamp& s = stamps_[i];
   frame.index = s.frame;
   frame.timestamp_ns = s.stamp_ns;
-  frame.images.resize(cameras_.size());
+  const bool depth = !depth_units_mm_.empty();
+  const std::size_t per = depth ? 2 : 1;  // depth: camera k's depth at 2k, its colour at 2k + 1
+  frame.images.resize(per * cameras_.size());
+  const auto load = [](const std::string& p, int flags, int type, const Camera& c) {
+    cv::Mat m = std::filesystem::exists(p) ? cv::imread(p, flags) : cv::Mat();
+    if (!m.empty() && (m.cols != c.width || m.rows != c.height || m.type() != type)) m = cv::Mat();
+    return m;  // missing, or not this camera's kind or size of image: nothing delivered
+  };
   for (std::size_t k = 0; k < cameras_.size(); ++k) {
-    const std::string p = replay_frame_path(dir_, k, s.frame);
-    frame.images[k] = std::filesystem::exists(p) ? cv::imread(p, cv::IMREAD_GRAYSCALE) : cv::Mat();
     const Camera& c = cameras_[k];
-    if (!frame.images[k].empty() && (frame.images[k].cols != c.width || frame.images[k].rows != c.height))
-      frame.images[k] = cv::Mat();  // wrong size: not this camera's image
+    if (!depth) {
+      frame.images[k] = load(replay_frame_path(dir_, k, s.frame), cv::IMREAD_GRAYSCALE, CV_8UC1, c);
+      continue;
+    }
+    frame.images[2 * k] =
+        load(replay_frame_path(dir_, k, s.frame), cv::IMREAD_UNCHANGED, CV_16UC1, c);
+    frame.images[2 * k + 1] =
+        load(replay_colour_path(dir_, k, s.frame), cv::IMREAD_COLOR, CV_8UC3, c);
   }
 }
 

@@ -1,7 +1,10 @@
 // Reads a recorded directory in the replay layout (camera_source.h), frame by frame, as recorded:
 //   DIR/camK.yaml            calibration of camera K
 //   DIR/camK/NNNNNN.png      frame NNNNNN of camera K (8-bit grey); missing = nothing that frame
-//   DIR/timestamps.csv       the header `frame,timestamp_ns`, then one line `INDEX,STAMP` per frame:
+//   (a depth recording, its calibrations with depth_unit_mm: camK/NNNNNN.png 16-bit depth and
+//   camK/NNNNNN.colour.png BGR; camera_source.h)
+//   DIR/timestamps.csv       the header `frame,timestamp_ns`, then one line `INDEX,STAMP` per
+//   frame:
 //                            INDEX a non-negative integer greater than the line before's, STAMP
 //                            integer nanoseconds (CLOCK_MONOTONIC of the recording machine), >= 0
 //                            and not decreasing; nothing else on a line
@@ -35,6 +38,8 @@ class ReplayReader {
   [[nodiscard]] const std::vector<Camera>& cameras() const { return cameras_; }
   [[nodiscard]] const std::vector<RecordedStamp>& stamps() const { return stamps_; }
   [[nodiscard]] std::size_t frames() const { return stamps_.size(); }
+  // A depth recording's unit per camera (mm per count); empty for grey cameras.
+  [[nodiscard]] const std::vector<double>& depth_units_mm() const { return depth_units_mm_; }
   // Decodes recorded frame i (< frames()) into `frame`: fresh images, the recorded index and
   // stamp. A missing or wrongly sized image is an empty one (that camera delivered nothing).
   void read(std::size_t i, Frame& frame) const;
@@ -43,6 +48,7 @@ class ReplayReader {
   std::string dir_;
   std::vector<Camera> cameras_;
   std::vector<RecordedStamp> stamps_;
+  std::vector<double> depth_units_mm_;
 };
 
 }  // namespace crease::vision

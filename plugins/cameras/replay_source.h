@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "plugins/camera_rig/depth_camera.h"
 #include "plugins/cameras/camera_source.h"
 #include "plugins/cameras/replay_reader.h"
 
@@ -44,6 +45,14 @@ class ReplaySource final : public CameraSource {
   ReplaySource& operator=(const ReplaySource&) = delete;
 
   [[nodiscard]] const std::vector<Camera>& cameras() const override { return reader_.cameras(); }
+  // A depth recording (camera_source.h's layout) plays into an RGB-D channel: depth, colour.
+  [[nodiscard]] std::vector<crease::frames::CameraSpec> channel_images() const override {
+    return reader_.depth_units_mm().empty() ? channel_specs(cameras())
+                                            : depth_channel_specs(cameras());
+  }
+  [[nodiscard]] std::vector<double> depth_units_mm() const override {
+    return reader_.depth_units_mm();
+  }
   // The next frame, paced and re-based as above; false after the last one or once cancelled.
   // Throws crease::Error when the decoder failed.
   bool grab(Frame& frame) override;

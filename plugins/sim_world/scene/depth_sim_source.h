@@ -28,6 +28,11 @@ class DepthSimSource final : public CameraSource {
                  RenderOptions render, DepthSensorModel sensor, DepthColourModel colour,
                  std::int64_t period_ns, std::int64_t start_ns = 0);
   [[nodiscard]] const std::vector<Camera>& cameras() const override { return cams_; }
+  [[nodiscard]] std::vector<double> depth_units_mm() const override {
+    std::vector<double> u;
+    for (const DepthCamera& c : depth_cams_) u.push_back(c.depth_unit_mm);
+    return u;
+  }
   [[nodiscard]] std::vector<crease::frames::CameraSpec> channel_images() const override {
     return depth_channel_specs(cams_);
   }

@@ -2,6 +2,7 @@
 // `frame,timestamp_ns`, then `INDEX,STAMP` lines of integers, frame indices increasing, stamps
 // not decreasing. Anything else is a crease::ConfigError naming the file and the line, never a
 // stamp quietly read as something else (seconds `0.066667` read as 0 made every stamp 0).
+// A depth recording (16-bit depth and colour PNGs) reads back as the recorder wrote it.
 #include "plugins/cameras/replay_reader.h"
 
 #include <doctest/doctest.h>
@@ -9,9 +10,9 @@
 
 #include <filesystem>
 #include <fstream>
-#include <string>
-
 #include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
 
 #include "core/errors.h"
 
@@ -97,5 +98,68 @@ TEST_CASE("a recorded directory with a bad timestamps.csv does not open; the rea
   CHECK(f.images[0].at<unsigned char>(10, 10) == 90);
   r.read(1, f);
   CHECK(f.images[0].empty());  // no file for frame 4: that camera delivered nothing
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE(
+    "a depth recording as the recorder writes it reads back bit for bit: 16-bit depth, colour, "
+    "units") {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("crease_depth_replay_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const std::vector<Camera> cams = {look_at_camera("a", 64, 48, 60, {0, -60, 450}, {0, 0, 0}),
+                                    look_at_camera("b", 64, 48, 60, {0, 60, 450}, {0, 0, 0})};
+  cv::RNG rng(3);
+  std::vector<Frame> written(3);
+  {
+    Recorder rec(dir.string(), cams, {1.0, 0.1});
+    for (std::size_t i = 0; i < written.size(); ++i) {
+      Frame& f = written[i];
+      f.index = i;
+      f.timestamp_ns = 1'000'000 + static_cast<std::int64_t>(i) * 33'333'333;
+      for (std::size_t k = 0; k < cams.size(); ++k) {
+        cv::Mat depth(48, 64, CV_16UC1), colour(48, 64, CV_8UC3);
+        rng.fill(depth, cv::RNG::UNIFORM, 0, 65536);
+        rng.fill(colour, cv::RNG::UNIFORM, 0, 256);
+        f.images.push_back(depth);
+        f.images.push_back(colour);
+      }
+    }
+    written[2].images[3] = cv::Mat();  // camera b's colour missing in the last frame
+    for (const Frame& f : written) rec.write(f);
+  }
+  const ReplayReader r(dir.string());
+  REQUIRE(r.frames() == written.size());
+  CHECK(r.depth_units_mm() == std::vector<double>{1.0, 0.1});
+  REQUIRE(r.cameras().size() == 2);
+  CHECK(r.cameras()[1].width == 64);
+  CHECK(r.cameras()[1].height == 48);
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    CAPTURE(i);
+    Frame f;
+    r.read(i, f);
+    CHECK(f.index == i);
+    CHECK(f.timestamp_ns == written[i].timestamp_ns);
+    REQUIRE(f.images.size() == 4);
+    for (std::size_t m = 0; m < 4; ++m) {
+      CAPTURE(m);
+      const cv::Mat& want = written[i].images[m];
+      REQUIRE(f.images[m].empty() == want.empty());
+      if (want.empty()) continue;
+      CHECK(f.images[m].type() == want.type());
+      CHECK(cv::norm(f.images[m], want, cv::NORM_INF) == 0);
+    }
+  }
+  // A depth image of another camera's size, or an 8-bit one where 16 bits belong: nothing
+  // delivered, never a wrong image.
+  REQUIRE(
+      cv::imwrite(replay_frame_path(dir.string(), 0, 0), cv::Mat(48, 64, CV_8UC1, cv::Scalar(7))));
+  REQUIRE(
+      cv::imwrite(replay_frame_path(dir.string(), 1, 0), cv::Mat(40, 64, CV_16UC1, cv::Scalar(7))));
+  Frame f;
+  r.read(0, f);
+  CHECK(f.images[0].empty());
+  CHECK(f.images[2].empty());
+  CHECK_FALSE(f.images[1].empty());
   std::filesystem::remove_all(dir);
 }
