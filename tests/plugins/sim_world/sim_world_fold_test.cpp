@@ -20,7 +20,8 @@
 // straight in at the pinch's height, into the hanging edge).
 // And the release of config/folds/half.yaml's (d)-(f): the pinch holds the laid layer while the
 // left index presses both layers, then opens its thumb, lifts off the edge and withdraws, and
-// leaves the fold as it was (failing variant: leaving with the thumb closed drags the edge away).
+// leaves the fold as it was (failing variant: leaving with the thumb closed drags the edge away);
+// it prints the highest fingertip force while the thumb opens (what a force limit would see).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -263,6 +264,8 @@ void print(const std::string& tag, const Fold& f) {
 // and as the pinch left it.
 struct Release {
   Fold pressed, left;
+  double opening_peak_n = 0;  // the right hand's highest fingertip force while the thumb opens
+  int opening_peak_tip = -1;  // which fingertip (0 ff .. 4 th)
 };
 
 Release release(Bimanual& b, bool open_thumb) {
@@ -281,6 +284,12 @@ Release release(Bimanual& b, bool open_thumb) {
     for (int i = 1; i <= 300; ++i) {
       b.r.q[THJ5] = kCloseThj5 * (1.0 - i / 300.0);
       b.step();
+      const auto& tips = b.hand(Side::right).tip;
+      for (int f = 0; f < static_cast<int>(std::size(tips)); ++f)
+        if (tips[f].normal_force_n > out.opening_peak_n) {
+          out.opening_peak_n = tips[f].normal_force_n;
+          out.opening_peak_tip = f;
+        }
     }
   move(b, b.r, b.r.at + Vec3{0, 0, 25}, 0.03);
   move(b, b.r, b.r.at + Vec3{0, -44, 0}, 0.03);
@@ -343,6 +352,8 @@ TEST_CASE("the pinch holds the laid layer until the other index holds both layer
   const Release r = release(b, true);
   print("pressed on both layers", r.pressed);
   print("released, lifted, withdrawn", r.left);
+  MESSAGE("while the thumb opened: the right hand's peak fingertip force "
+          << r.opening_peak_n << " N (fingertip " << r.opening_peak_tip << ")");
   CHECK(r.pressed.on_top > 0.9);
   CHECK(r.left.on_top > 0.9);
   CHECK(std::fabs(r.left.edges_apart_mm - r.pressed.edges_apart_mm) < 3.0);  // the fold as it was
