@@ -13,7 +13,6 @@
 // per cycle p50 / p99 / max of the whole stage, and of the arms and the hands apart, against the
 // issue's target (the whole stage p99 <= 20 us) and KDL's LMA per call. The drivers are not in
 // it (their cost is the bus's: crease-bench bus).
-#include <kdl/chainiksolverpos_lma.hpp>
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -23,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <kdl/chainiksolverpos_lma.hpp>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -35,6 +35,7 @@
 #include "plugins/arm_motion/arm_motion.h"
 #include "plugins/robot_model/arm_ik.h"
 #include "plugins/sim_world/world_config.h"
+#include "rt/rt_setup.h"
 
 namespace {
 
@@ -252,10 +253,18 @@ StageTimes bench_stage(RobotModel& m, double seconds, bool paced) {
   std::vector<ArmGoal> pending(2);
   std::uint32_t id = 0;
   int onsets = 0;
-  // Paced at 1 kHz like the control loop (absolute deadlines), SCHED_FIFO where permitted.
+  // Paced at 1 kHz like the control loop (absolute deadlines), SCHED_FIFO where permitted, with
+  // the real-time setup creased applies on the robot (config/robot.yaml: memory locked,
+  // daemon.cpu_dma_latency_us 0, which cyclictest also holds), each step printed.
   sched_param sp{};
   sp.sched_priority = 80;
   const bool fifo = paced && pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+  crease::rt::DmaLatencyRequest dma;
+  if (paced) {
+    for (const crease::rt::SetupStep& st : {crease::rt::lock_memory(64u << 20), dma.request(0)})
+      std::printf("  paced run: %s: %s%s\n", st.what.c_str(),
+                  st.applied ? "applied" : "not applied: ", st.why.c_str());
+  }
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
   for (int c = 0; c < cycles; ++c) {
