@@ -32,7 +32,6 @@ ArmIk::ArmIk(const RobotModel& model, Side side, const Options& options) : opt_(
       throw ConfigError(model.urdf_file() + ": the arm's chain must hold S1..W2 in order");
     }
   }
-  fk_ = std::make_unique<KDL::ChainFkSolverPos_recursive>(*chain_);
   rt_chain_ = std::make_unique<ArmChainRt>(*chain_);
   q_.resize(kArmJoints);
   tools_.reserve(kToolFrames);
@@ -60,17 +59,15 @@ bool ArmIk::set_tool(ToolFrame tool, std::span<const double, kArmJoints> arm, Ha
 
 KDL::Frame ArmIk::tool_pose(std::span<const double, kArmJoints> q) noexcept {
   for (int j = 0; j < kArmJoints; ++j) q_(j) = q[j];
-  if (fk_->JntToCart(q_, f_) < 0) return KDL::Frame::Identity();
+  std::array<Eigen::Vector3d, kArmJoints> axis, origin;
+  (void)pass(axis, origin);
   return f_ * flange_tool_;
 }
 
-void ArmIk::pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept {
-  // One pass down the chain (ArmChainRt): each joint's axis and origin in the world before its
-  // own motion, then the flange; column j = [a_j x (p_tool - o_j); a_j] (the geometric Jacobian
-  // at the tool frame's origin, what KDL's ChainJntToJacSolver with changeRefPoint gives).
+Eigen::Isometry3d ArmIk::pass(std::array<Eigen::Vector3d, kArmJoints>& axis,
+                              std::array<Eigen::Vector3d, kArmJoints>& origin) noexcept {
   std::array<double, kArmJoints> q;
   for (int j = 0; j < kArmJoints; ++j) q[static_cast<std::size_t>(j)] = q_(j);
-  std::array<Eigen::Vector3d, kArmJoints> axis, origin;
   Eigen::Isometry3d flange;
   rt_chain_->pass(q, axis, origin, flange);
   const Eigen::Matrix3d& r = flange.linear();
@@ -78,6 +75,15 @@ void ArmIk::pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept 
   f_ = KDL::Frame(KDL::Rotation(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0),
                                 r(2, 1), r(2, 2)),
                   KDL::Vector(p.x(), p.y(), p.z()));
+  return flange;
+}
+
+void ArmIk::pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept {
+  // Each joint's axis and origin in the world before its own motion, then the flange; column
+  // j = [a_j x (p_tool - o_j); a_j] (the geometric Jacobian at the tool frame's origin, what
+  // KDL's ChainJntToJacSolver with changeRefPoint gives).
+  std::array<Eigen::Vector3d, kArmJoints> axis, origin;
+  const Eigen::Isometry3d flange = pass(axis, origin);
   const Eigen::Vector3d p_tool =
       flange * Eigen::Vector3d(flange_tool_.p.x(), flange_tool_.p.y(), flange_tool_.p.z());
   for (int k = 0; k < kArmJoints; ++k) {

@@ -34,7 +34,6 @@
 #include <array>
 #include <cstdint>
 #include <kdl/chain.hpp>
-#include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
 #include <memory>
@@ -119,12 +118,15 @@ class ArmIk {
   bool iterate(const KDL::Frame& target, int max_iterations, double rest_gain, double rest_max_step, double tol_m,
                double tol_rad, Result& r) noexcept;
   void pose_and_jacobian(Eigen::Matrix<double, 6, kArmJoints>& J) noexcept;  // at q_; sets f_
+  // One pass down the chain at q_ (arm_chain_rt.h): sets f_, returns the flange pose.
+  Eigen::Isometry3d pass(std::array<Eigen::Vector3d, kArmJoints>& axis,
+                         std::array<Eigen::Vector3d, kArmJoints>& origin) noexcept;
   void random_seed(std::span<double, kArmJoints> q) noexcept;
 
   Options opt_;
   std::unique_ptr<KDL::Chain> chain_;  // heap: the solvers keep references to it
-  std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk_;
-  std::unique_ptr<ArmChainRt> rt_chain_;  // the same chain for the iterations' passes
+  std::unique_ptr<ArmChainRt>
+      rt_chain_;  // the chain's one forward kinematics (tool_pose, the iterations)
   std::vector<ToolChain> tools_;       // world -> each tool frame, for set_tool
   std::unique_ptr<ToolChain> flange_chain_;
   KDL::JntArray q_;
