@@ -21,8 +21,7 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 ArmIk::ArmIk(const RobotModel& model, Side side, const Options& options) : opt_(options) {
   const std::string prefix = model.params().side(side).prefix;
   flange_chain_ = std::make_unique<ToolChain>(model.make_chain(side, prefix + "flange"));
-  chain_ = std::make_unique<KDL::Chain>(flange_chain_->chain());
-  if (chain_->getNrOfJoints() != static_cast<unsigned>(kArmJoints)) {
+  if (flange_chain_->chain().getNrOfJoints() != static_cast<unsigned>(kArmJoints)) {
     throw ConfigError(model.urdf_file() + ": the world -> " + prefix + "flange chain must hold the arm's 7 joints");
   }
   const auto& sources = flange_chain_->sources();
@@ -32,7 +31,7 @@ ArmIk::ArmIk(const RobotModel& model, Side side, const Options& options) : opt_(
       throw ConfigError(model.urdf_file() + ": the arm's chain must hold S1..W2 in order");
     }
   }
-  rt_chain_ = std::make_unique<ArmChainRt>(*chain_);
+  rt_chain_ = std::make_unique<ArmChainRt>(flange_chain_->chain());
   q_.resize(kArmJoints);
   tools_.reserve(kToolFrames);
   for (int f = 0; f < kToolFrames; ++f) {

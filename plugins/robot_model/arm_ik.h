@@ -111,7 +111,7 @@ class ArmIk {
   [[nodiscard]] const Joints& upper() const noexcept { return hi_; }
   [[nodiscard]] const Joints& velocity_limit() const noexcept { return vmax_; }
   [[nodiscard]] const Options& options() const noexcept { return opt_; }
-  [[nodiscard]] const KDL::Chain& arm_chain() const noexcept { return *chain_; }
+  [[nodiscard]] const KDL::Chain& arm_chain() const noexcept { return flange_chain_->chain(); }
 
  private:
   // Iterations from q_ (in place); returns whether converged. ITERATIONS counted in R.
@@ -124,7 +124,6 @@ class ArmIk {
   void random_seed(std::span<double, kArmJoints> q) noexcept;
 
   Options opt_;
-  std::unique_ptr<KDL::Chain> chain_;  // heap: the solvers keep references to it
   std::unique_ptr<ArmChainRt>
       rt_chain_;  // the chain's one forward kinematics (tool_pose, the iterations)
   std::vector<ToolChain> tools_;       // world -> each tool frame, for set_tool
