@@ -55,19 +55,17 @@ struct Dds<crease::Keypoints> {
   // `src.count` must not exceed kCapacity (a value that left a port never does: all_finite()).
   static void to_dds(const crease::Keypoints& src, C& dst, Scratch& scratch) noexcept {
     CREASE_KEYPOINTS_HEADER_FIELDS(CREASE_DDS_COPY_, CREASE_DDS_COPY_)
-    const std::uint32_t n = src.count <= crease::Keypoints::kCapacity ? src.count : crease::Keypoints::kCapacity;
-    for (std::uint32_t i = 0; i < n; ++i) copy_point(src.points[i], scratch.points[i]);
-    lend_sequence(dst.points, scratch.points, n, crease::Keypoints::kCapacity);
+    lend_copies(dst.points, src.points, src.count, scratch.points,
+                [](const auto& s, auto& d) { copy_point(s, d); });
   }
+  // A corner over 4 or a face over 1 is malformed; more points than kCapacity oversized.
   static SampleCheck from_dds(const C& src, crease::Keypoints& dst) noexcept {
-    if (src.points._length > crease::Keypoints::kCapacity) return SampleCheck::oversized;
     CREASE_KEYPOINTS_HEADER_FIELDS(CREASE_DDS_COPY_, CREASE_DDS_COPY_)
-    dst.count = src.points._length;
-    for (std::uint32_t i = 0; i < dst.count; ++i) {
-      const crease_msgs_msg_dds__Keypoint_& p = src.points._buffer[i];
-      if (p.corner > 4 || p.face > 1) return SampleCheck::malformed;
-      copy_point(p, dst.points[i]);
-    }
+    const SampleCheck c = take_sequence(
+        src.points, dst.points, dst.count,
+        [](const auto& p) { return p.corner <= 4 && p.face <= 1; },
+        [](const auto& s, auto& d) { copy_point(s, d); });
+    if (c != SampleCheck::ok) return c;
     return crease::payload_is_finite(dst) ? SampleCheck::ok : SampleCheck::malformed;
   }
 

@@ -20,6 +20,8 @@
 #include <cstring>
 #include <type_traits>
 
+#include "sample_check.h"
+
 namespace crease::dds_bridge {
 
 // The representation a field is compared by: enums as their underlying type, arrays element-wise.
@@ -60,6 +62,30 @@ inline void lend_sequence(Seq& seq, E* buffer, std::uint32_t length,
   seq._length = length;
   seq._buffer = buffer;
   seq._release = false;
+}
+
+// A port payload's bounded array out to a sequence: the first COUNT (at most N) elements of SRC
+// converted by COPY into SCRATCH, which SEQ then borrows (lend_sequence).
+template <class Seq, class S, class E, std::size_t N, class Copy>
+inline void lend_copies(Seq& seq, const S (&src)[N], std::uint32_t count, E (&scratch)[N],
+                        Copy copy) noexcept {
+  const std::uint32_t n = count <= N ? count : static_cast<std::uint32_t>(N);
+  for (std::uint32_t i = 0; i < n; ++i) copy(src[i], scratch[i]);
+  lend_sequence(seq, scratch, n, static_cast<std::uint32_t>(N));
+}
+
+// A received sequence into a port payload's bounded array DST (its length into COUNT): more than
+// N elements is oversized, an element VALID refuses malformed; each converted by COPY.
+template <class Seq, class D, std::size_t N, class Valid, class Copy>
+inline SampleCheck take_sequence(const Seq& seq, D (&dst)[N], std::uint32_t& count, Valid valid,
+                                 Copy copy) noexcept {
+  if (seq._length > N) return SampleCheck::oversized;
+  count = seq._length;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (!valid(seq._buffer[i])) return SampleCheck::malformed;
+    copy(seq._buffer[i], dst[i]);
+  }
+  return SampleCheck::ok;
 }
 
 }  // namespace crease::dds_bridge

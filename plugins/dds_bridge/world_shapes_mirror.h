@@ -62,25 +62,21 @@ struct Dds<crease::WorldShapes> {
   // `src.count` must not exceed kCapacity (a value that left a port never does: all_finite()).
   static void to_dds(const crease::WorldShapes& src, C& dst, Scratch& scratch) noexcept {
     CREASE_WORLD_SHAPES_HEADER_FIELDS(CREASE_DDS_COPY_, CREASE_DDS_COPY_)
-    const std::uint32_t n =
-        src.count <= crease::WorldShapes::kCapacity ? src.count : crease::WorldShapes::kCapacity;
-    for (std::uint32_t i = 0; i < n; ++i) copy_shape(src.shapes[i], scratch.shapes[i]);
-    lend_sequence(dst.shapes, scratch.shapes, n, crease::WorldShapes::kCapacity);
+    lend_copies(dst.shapes, src.shapes, src.count, scratch.shapes,
+                [](const auto& s, auto& d) { copy_shape(s, d); });
   }
   // A kind, role or side out of its enum's range is malformed; more shapes than kCapacity
   // oversized.
   static SampleCheck from_dds(const C& src, crease::WorldShapes& dst) noexcept {
-    if (src.shapes._length > crease::WorldShapes::kCapacity) return SampleCheck::oversized;
     CREASE_WORLD_SHAPES_HEADER_FIELDS(CREASE_DDS_COPY_, CREASE_DDS_COPY_)
-    dst.count = src.shapes._length;
     dst.reserved = 0;
-    for (std::uint32_t i = 0; i < dst.count; ++i) {
-      const crease_msgs_msg_dds__WorldShape_& s = src.shapes._buffer[i];
-      if (s.kind > static_cast<std::uint8_t>(crease::WorldShapes::Kind::box) ||
-          s.role > static_cast<std::uint8_t>(crease::WorldShapes::Role::arm) || s.side > 1)
-        return SampleCheck::malformed;
-      copy_shape(s, dst.shapes[i]);
-    }
+    const auto valid = [](const auto& s) {
+      return s.kind <= static_cast<std::uint8_t>(crease::WorldShapes::Kind::box) &&
+             s.role <= static_cast<std::uint8_t>(crease::WorldShapes::Role::arm) && s.side <= 1;
+    };
+    const SampleCheck c = take_sequence(src.shapes, dst.shapes, dst.count, valid,
+                                        [](const auto& s, auto& d) { copy_shape(s, d); });
+    if (c != SampleCheck::ok) return c;
     return crease::payload_is_finite(dst) ? SampleCheck::ok : SampleCheck::malformed;
   }
 
