@@ -117,12 +117,15 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : params
   cfg.finger_friction = params_.finger_friction;
   cfg.table_friction_on = params_.table_friction;
   contacts_.configure(*sheet_, shapes_, cfg);
+  thumb_contacts_.configure(shapes_, params_.table_contact_area_mm2);
   pose_pre_.resize(shapes_.size());
   pose_target_.resize(shapes_.size());
   sheet_->set_substep_contacts(&contacts_);
 
-  const std::size_t cap = static_cast<std::size_t>(sheet_->node_count()) * FingerContacts::kMaxShapesPerNode + shapes_.size();
   for (int s = 0; s < robot::kSides; ++s) {
+    const std::size_t cap =
+        static_cast<std::size_t>(sheet_->node_count()) * FingerContacts::kMaxShapesPerNode +
+        shapes_.size() + static_cast<std::size_t>(thumb_contacts_.pairs(s));
     hand_contacts_[s].resize(cap);
     hand_contact_shape_[s].resize(cap);
     hand_contact_shape2_[s].resize(cap);
@@ -289,6 +292,13 @@ void World::settle_hand_rt(int side) noexcept {
                    {}};
     shape_of[n] = k;
     shape2_of[n++] = -1;
+  }
+  // The thumb against the other fingers.
+  if (params_.hand_contacts && params_.thumb_contacts) {
+    const std::size_t room = contacts.size() - static_cast<std::size_t>(n);
+    n += thumb_contacts_.measure_rt(side, pose_pre_, std::span(contacts.data() + n, room),
+                                    std::span(shape_of.data() + n, room),
+                                    std::span(shape2_of.data() + n, room));
   }
   // Friction acts on the sheet and is reported per fingertip, but does not bend the joints:
   // fed back explicitly, a Coulomb force that flips with every small slip drives a finger as

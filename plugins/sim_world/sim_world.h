@@ -35,6 +35,7 @@
 #include "plugins/sim_world/randomise.h"
 #include "plugins/sim_world/robot_shapes.h"
 #include "plugins/sim_world/side_kinematics.h"
+#include "plugins/sim_world/thumb_contacts.h"
 #include "plugins/sim_world/world_params.h"
 
 namespace crease::world {
@@ -134,6 +135,7 @@ class World {
   std::vector<Pose> pose_pre_;     // per shape: where the new commands put it with the last deflection
   std::vector<Pose> pose_target_;  // per shape: where the commanded targets alone put it
   FingerContacts contacts_;
+  ThumbContacts thumb_contacts_;
   std::array<HandSim, robot::kSides> hand_;
   std::array<std::unique_ptr<HandCompliance>, robot::kSides> compliance_;
   // Per side, this step: the contacts the hand settled against, their shapes and forces (N).

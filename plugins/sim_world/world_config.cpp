@@ -84,6 +84,7 @@ WorldPluginConfig read_world_config(const Params& p) {
   w.initial_hand_rad[1] = read_angles_deg(p, "hand_l_deg", zero_hand);
   // The physics switches (world_params.h), for the failing variants of tests.
   w.hand_contacts = p.get<bool>("hand_contacts", true);
+  w.thumb_contacts = p.get<bool>("thumb_contacts", true);
   w.finger_friction = p.get<bool>("finger_friction", true);
   w.table_friction = p.get<bool>("table_friction", true);
   w.joint_compliance = p.get<bool>("joint_compliance", true);

@@ -68,6 +68,7 @@ struct WorldParams {
 
   // Physics switches, all on in the real world; each test turns one off for its failing variant.
   bool hand_contacts = true;     // the hands' shapes push the sheet (and feel it)
+  bool thumb_contacts = true;    // the thumb's covers press the other fingers' (thumb_contacts.h)
   bool finger_friction = true;   // Coulomb friction between the hands and the sheet
   bool table_friction = true;    // Coulomb friction between the sheet and the table
   bool joint_compliance = true;  // the hand joints are springs (else rigid at their targets)
