@@ -61,7 +61,7 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.via_mm[1][2] == -60.3);  // [u, v, h]: h above the sheet is the sheet frame's -z
   CHECK(h.shift.fingers == 0x03);
   CHECK(h.lay_mm[1] == 14.5);
-  CHECK(h.lay_mm[2] == -12.0);
+  CHECK(h.lay_mm[2] == -22.0);
   CHECK(h.refixate_out_mm[0] == 255.0);
   CHECK(h.refixate_out_force_n == 0.5);
   CHECK(h.swipe_withdraw_mm[2] == -37.0);
@@ -114,8 +114,8 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(e.find("fold.swipe.tool: unknown tool frame 'ff_bak'") != std::string::npos);
   }
   SUBCASE("a missing lay point, where the fixing hand slides out to") {
-    CHECK(error_of(variant("  lay_mm: [105, 14.5, 12]\n", "  {}\n")).find("fold.fixate_layer.lay_mm: required") !=
-          std::string::npos);
+    CHECK(error_of(variant("  lay_mm: [105, 14.5, 22]\n", "  {}\n"))
+              .find("fold.fixate_layer.lay_mm: required") != std::string::npos);
     CHECK(error_of(variant("  out_mm: [255, 88.5]", "  out_mm: [255]")).find("fold.refixate.out_mm: expected a list of 2") !=
           std::string::npos);
   }
