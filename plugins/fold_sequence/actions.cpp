@@ -88,6 +88,24 @@ void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
   arm_move(side, m_.arm_tool[side], ArmGoal::measured, p, q, spec_.retreat, 0, out);
 }
 
+bool Machine::back_out_of_grasp(Outbox& out) noexcept {
+  if (m_.aborted_from != S::grasp_reach && m_.aborted_from != S::grasp_pinch) return false;
+  if (!m_.arm_has_target[kPinching]) return false;
+  // The pinching tool went in under the sheet's edge round its overhang (grasp_path_mm, e.g.
+  // under the table top beyond its edge): straight up from there is into the table from below.
+  // Back out the way it came, then to above_mm; slowly (contact limits), as it went in.
+  const FoldSpec& f = spec_;
+  const int n = f.grasp_path_count;
+  double path[kMaxGraspPath + 1][3], turn[kMaxGraspPath + 1][4];
+  for (int k = 0; k <= n; ++k) {
+    for (int c = 0; c < 3; ++c)
+      path[k][c] = k < n ? f.grasp_path_mm[n - 1 - k][c] : f.grasp_above_mm[c];
+    for (int c = 0; c < 4; ++c) turn[k][c] = f.grasp_orientation[c];
+  }
+  arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n + 1, path, turn, f.contact, 0, out);
+  return true;
+}
+
 void Machine::arm_park(int side, Outbox& out, bool joints) noexcept {
   const int s = side_of_role(spec_, side);  // park poses are per side
   const int before = out.arm_count[side];
@@ -214,6 +232,7 @@ void Machine::retry_retreat(const Sensing& in, Outbox& out) noexcept {
       continue;
     out.retried[s] = end_reason(*a, m_.arm_id[s]);
     if (m_.leaf == S::abort_lift) {
+      if (s == kPinching && back_out_of_grasp(out)) continue;  // the way it came, again
       arm_lift(s, spec_.release_lift_mm, out);  // from where it is now: up again
       continue;
     }
@@ -389,9 +408,12 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       hand_posture(kPinching, f.open_rad, in, out);
       break;
     case S::finish_lift:
-    case S::abort_lift:
       arm_lift(kFixing, f.release_lift_mm, out);
       arm_lift(kPinching, f.release_lift_mm, out);
+      break;
+    case S::abort_lift:
+      arm_lift(kFixing, f.release_lift_mm, out);
+      if (!back_out_of_grasp(out)) arm_lift(kPinching, f.release_lift_mm, out);
       break;
     case S::finish_park:
     case S::abort_park:

@@ -127,6 +127,7 @@ void Machine::go(S to, Reason r, int row, const Sensing& in, Outbox& out) noexce
     m_.abort_reason = r;
     abort_detail_ = row >= 0 && all_rows().begin[row].ev == Ev::fault ? detail_ : nullptr;
   }
+  if (is_within(to, S::abort) && !is_within(from, S::abort)) m_.aborted_from = from;
   m_.self_entry = self ? 1 : 0;
   S x = to;
   for (int i = k - 1; i >= 0; --i) {

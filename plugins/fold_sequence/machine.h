@@ -94,8 +94,8 @@ struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
   // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
-  // park in joint space, halved while out of reach)
-  static constexpr std::uint32_t kVersion = 5;
+  // park in joint space, halved while out of reach); 6: aborted_from
+  static constexpr std::uint32_t kVersion = 6;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -107,6 +107,8 @@ struct Memory {
   std::uint8_t self_entry = 0;      // the entry running is a self-transition's
   Reason last_reason = Reason::none;
   Reason abort_reason = Reason::none;
+  S aborted_from =
+      S::idle;  // the leaf the abort came from (the retreat's lift backs out of a grasp)
   std::int16_t last_row = -1;       // index into all_rows() of the last transition; -1 none
   std::int16_t gate_row = -1;       // step mode: the transition held until `step`
   std::uint32_t transitions = 0;
@@ -199,6 +201,9 @@ class Machine {
   void arm_stop(int side, Outbox& out) noexcept;
   void arm_lift(int side, double lift_mm, Outbox& out) noexcept;
   void arm_park(int side, Outbox& out, bool joints = false) noexcept;
+  // The abort's lift of the pinching hand when the abort came from the grasp's reach or pinch:
+  // back along the reach path to above_mm (false: not from there, nothing sent). RT.
+  bool back_out_of_grasp(Outbox& out) noexcept;
   // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
   // pinch as the bend laid it (lay, withdraw).
   void pinch_as_laid(const double p[3], Outbox& out) noexcept;

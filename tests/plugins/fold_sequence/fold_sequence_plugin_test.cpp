@@ -63,10 +63,19 @@ void check_retreat(const Rig& r, long abort_cycle) {
     CHECK(arm.back()->arm_goal.frame == ArmGoal::world);  // parked
     CHECK(arm.back()->arm_goal.position_mm[0][2] == 300.0);
     // An arm that had moved lifts first: straight up by release_lift_mm from where it is
-    // measured (arm_motion's `measured` frame, the orientation kept), not from its last target.
+    // measured (arm_motion's `measured` frame, the orientation kept), not from its last target;
+    // the pinching one aborted in the grasp's reach or pinch backs out along the reach path to
+    // above_mm instead (half.yaml: two points back, then [105, 338.5, 39.5] in the sheet frame).
     for (std::size_t i = 1; i + 1 < arm.size(); ++i) {
       const ArmGoal& g = arm[i]->arm_goal;
       CHECK(g.kind == ArmGoal::move);
+      if (g.frame == ArmGoal::sheet) {
+        CHECK(s == kPin);
+        REQUIRE(g.point_count == 3);
+        CHECK(g.position_mm[2][1] == doctest::Approx(338.5));
+        CHECK(g.position_mm[2][2] == doctest::Approx(-39.5));
+        continue;
+      }
       CHECK(g.frame == ArmGoal::measured);
       CHECK(g.position_mm[0][0] == 0.0);
       CHECK(g.position_mm[0][1] == 0.0);

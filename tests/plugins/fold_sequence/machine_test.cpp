@@ -165,3 +165,50 @@ TEST_CASE(
       CHECK(st.abort_reason == static_cast<std::uint8_t>(c.reason));
     }
 }
+
+TEST_CASE(
+    "an abort from the grasp's reach backs the pinching hand out the way it went in, then to "
+    "above") {
+  // half.yaml's reach: from above beyond the far edge, down to 35.5 mm under the table top, in
+  // under the overhang, up to the sheet. Lifted straight up from there the hand rose into the
+  // table from below (a trial: the index 40 mm under the top, pressing 1026 N).
+  const FoldSpec f = half();
+  REQUIRE(f.grasp_path_count == 2);
+  for (const S from : {S::grasp_reach, S::grasp_pinch, S::follow_via}) {
+    CAPTURE(static_cast<int>(from));
+    Machine m(f);
+    Memory saved = m.memory();
+    saved.leaf = from;
+    saved.arm_has_target[kFixing] = saved.arm_has_target[kPinching] = 1;
+    saved.arm_tool[kPinching] = f.grasp_tool;
+    REQUIRE(m.restore(saved));
+    Quiet q;
+    Outbox out;
+    std::int64_t now = 1'000'000;
+    m.fail(Reason::force_limit);
+    m.step(q.at(now), out);
+    REQUIRE(m.memory().leaf == S::abort_stop);
+    CHECK(m.memory().aborted_from == from);
+    for (int k = 0; k < 10 && m.memory().leaf != S::abort_lift; ++k) {
+      now += 30'000'000'000;  // past every timeout: stop, open
+      m.step(q.at(now), out);
+    }
+    REQUIRE(m.memory().leaf == S::abort_lift);
+    REQUIRE(out.arm_count[kPinching] == 1);
+    REQUIRE(out.arm_count[kFixing] == 1);
+    const ArmGoal& pin = out.arm[kPinching][0];
+    CHECK(out.arm[kFixing][0].frame == ArmGoal::measured);  // the fixing hand lifts
+    if (from == S::follow_via) {
+      CHECK(pin.frame == ArmGoal::measured);  // straight up
+      CHECK(pin.point_count == 1);
+      continue;
+    }
+    REQUIRE(pin.frame == ArmGoal::sheet);
+    REQUIRE(pin.point_count == 3);
+    for (int c = 0; c < 3; ++c) {
+      CHECK(pin.position_mm[0][c] == doctest::Approx(f.grasp_path_mm[1][c]));  // under the overhang
+      CHECK(pin.position_mm[1][c] == doctest::Approx(f.grasp_path_mm[0][c]));  // beyond the edge
+      CHECK(pin.position_mm[2][c] == doctest::Approx(f.grasp_above_mm[c]));    // above it
+    }
+  }
+}
