@@ -17,12 +17,16 @@ namespace crease {
 
 struct ArmGoal {
   static constexpr char kPortType[] = "crease.ArmGoal";
-  static constexpr std::uint32_t kPortVersion = 2;  // 2: interpolation
+  static constexpr std::uint32_t kPortVersion = 3;  // 2: interpolation; 3: kind retreat
   static constexpr int kMaxPoints = 8;
 
   enum Kind : std::uint8_t {
     move = 0,  // run the motion below (refused as busy while another one is active)
     stop = 1,  // decelerate whatever runs at its stop deceleration and hold (nothing else read)
+    // A move back out the way the tool went in (the sender vouches for the path: e.g. the
+    // grasp's reach in reverse): taken, and kept running, while the hand's controller retreats,
+    // as a lift is; any other move is refused then (hand_retreat).
+    retreat = 2,
   };
   enum Frame : std::uint8_t {
     world = 0,  // points in the world frame

@@ -163,8 +163,10 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   }
   path.pose[0] = to_pose(ik_.tool_pose(q_cmd));
   path.count = g.point_count + 1;
-  // While the hand retreats only a lift goes (away from what it pressed); any other is refused.
-  const bool lift = g.interpolation == ArmGoal::cartesian && path_is_lift(path);
+  // While the hand retreats only a lift, or a retreat the sender vouches for, goes (away from
+  // what it pressed); any other is refused.
+  const bool lift =
+      g.kind == ArmGoal::retreat || (g.interpolation == ArmGoal::cartesian && path_is_lift(path));
   if (!lift && hand_retreating(in)) {
     refuse(g.id, ArmMotionReason::hand_retreat);
     return;

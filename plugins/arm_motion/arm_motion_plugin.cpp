@@ -71,8 +71,9 @@ class ArmMotionPlugin final : public Plugin {
       const KDL::Frame* sheet = nullptr;
       KDL::Frame world_sheet;
       // The sheet (164 kB) is copied only when a goal needs it.
-      if (goal.kind == ArmGoal::move && goal.frame == ArmGoal::sheet && sheet_.poll().has_data() &&
-          static_cast<double>(cycle.time_ns - sheet_.value().timestamp_ns) * 1e-9 <= params_.sheet_state_max_age_s &&
+      if (goal.kind != ArmGoal::stop && goal.frame == ArmGoal::sheet && sheet_.poll().has_data() &&
+          static_cast<double>(cycle.time_ns - sheet_.value().timestamp_ns) * 1e-9 <=
+              params_.sheet_state_max_age_s &&
           am::sheet_frame_m(sheet_.value(), world_sheet)) {
         sheet = &world_sheet;
       }

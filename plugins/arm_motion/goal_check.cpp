@@ -9,9 +9,11 @@ namespace crease::arm_motion {
 
 ArmMotionReason check_goal(const ArmGoal& g, const GoalLimits& l) noexcept {
   if (g.kind == ArmGoal::stop) return ArmMotionReason::none;
-  if (g.kind != ArmGoal::move || (g.frame != ArmGoal::world && g.frame != ArmGoal::sheet && g.frame != ArmGoal::measured) ||
-      (g.stop_on != ArmGoal::stop_none && g.stop_on != ArmGoal::contact_onset) || g.point_count == 0 ||
-      g.point_count > ArmGoal::kMaxPoints || (g.stop_on != ArmGoal::stop_none && (g.stop_fingers & 0x1f) == 0)) {
+  if ((g.kind != ArmGoal::move && g.kind != ArmGoal::retreat) ||
+      (g.frame != ArmGoal::world && g.frame != ArmGoal::sheet && g.frame != ArmGoal::measured) ||
+      (g.stop_on != ArmGoal::stop_none && g.stop_on != ArmGoal::contact_onset) ||
+      g.point_count == 0 || g.point_count > ArmGoal::kMaxPoints ||
+      (g.stop_on != ArmGoal::stop_none && (g.stop_fingers & 0x1f) == 0)) {
     return ArmMotionReason::bad_points;
   }
   if (g.interpolation != ArmGoal::cartesian &&

@@ -2,6 +2,7 @@
 // arms' motions (arm_goal), the hands' force controllers (hand_goal) and the sheet model
 // (sheet_crease, sheet_memorize). Points from the fold file, in the sheet frame arm_motion
 // resolves when each motion starts; the parking poses in the world frame.
+#include <algorithm>
 #include <cmath>
 
 #include "plugins/fold_sequence/machine.h"
@@ -94,15 +95,23 @@ bool Machine::back_out_of_grasp(Outbox& out) noexcept {
   // The pinching tool went in under the sheet's edge round its overhang (grasp_path_mm, e.g.
   // under the table top beyond its edge): straight up from there is into the table from below.
   // Back out the way it came, then to above_mm; slowly (contact limits), as it went in.
+  // The reach's points are path 0..n-1 then at_mm; segment k runs towards point k, so points
+  // 0..k-1 were passed (the pinch: all of them; unknown: none, it was still above).
   const FoldSpec& f = spec_;
   const int n = f.grasp_path_count;
+  int passed = n;
+  if (m_.aborted_from == S::grasp_reach)
+    passed = m_.aborted_segment == Memory::kNoSegment ? 0 : std::min<int>(m_.aborted_segment, n);
   double path[kMaxGraspPath + 1][3], turn[kMaxGraspPath + 1][4];
-  for (int k = 0; k <= n; ++k) {
+  for (int k = 0; k <= passed; ++k) {
     for (int c = 0; c < 3; ++c)
-      path[k][c] = k < n ? f.grasp_path_mm[n - 1 - k][c] : f.grasp_above_mm[c];
+      path[k][c] = k < passed ? f.grasp_path_mm[passed - 1 - k][c] : f.grasp_above_mm[c];
     for (int c = 0; c < 4; ++c) turn[k][c] = f.grasp_orientation[c];
   }
-  arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n + 1, path, turn, f.contact, 0, out);
+  const int before = out.arm_count[kPinching];
+  arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, passed + 1, path, turn, f.contact, 0, out);
+  if (out.arm_count[kPinching] > before)
+    out.arm[kPinching][before].kind = ArmGoal::retreat;  // taken while the hand retreats
   return true;
 }
 

@@ -127,7 +127,12 @@ void Machine::go(S to, Reason r, int row, const Sensing& in, Outbox& out) noexce
     m_.abort_reason = r;
     abort_detail_ = row >= 0 && all_rows().begin[row].ev == Ev::fault ? detail_ : nullptr;
   }
-  if (is_within(to, S::abort) && !is_within(from, S::abort)) m_.aborted_from = from;
+  if (is_within(to, S::abort) && !is_within(from, S::abort)) {
+    m_.aborted_from = from;
+    const ArmMotionStatus* a = in.arm[kPinching];  // how far the pinching arm's goal had come
+    m_.aborted_segment =
+        a != nullptr && a->goal_id == m_.arm_id[kPinching] ? a->segment : Memory::kNoSegment;
+  }
   m_.self_entry = self ? 1 : 0;
   S x = to;
   for (int i = k - 1; i >= 0; --i) {

@@ -107,8 +107,11 @@ struct Memory {
   std::uint8_t self_entry = 0;      // the entry running is a self-transition's
   Reason last_reason = Reason::none;
   Reason abort_reason = Reason::none;
-  S aborted_from =
-      S::idle;  // the leaf the abort came from (the retreat's lift backs out of a grasp)
+  // The leaf the abort came from, and the pinching arm's path segment then (its status's): the
+  // retreat's lift backs out of a grasp the way it went in.
+  static constexpr std::uint8_t kNoSegment = 0xff;
+  S aborted_from = S::idle;
+  std::uint8_t aborted_segment = kNoSegment;
   std::int16_t last_row = -1;       // index into all_rows() of the last transition; -1 none
   std::int16_t gate_row = -1;       // step mode: the transition held until `step`
   std::uint32_t transitions = 0;
@@ -202,7 +205,8 @@ class Machine {
   void arm_lift(int side, double lift_mm, Outbox& out) noexcept;
   void arm_park(int side, Outbox& out, bool joints = false) noexcept;
   // The abort's lift of the pinching hand when the abort came from the grasp's reach or pinch:
-  // back along the reach path to above_mm (false: not from there, nothing sent). RT.
+  // back along the reach path's points it had passed (a reach aborted on its way: those before
+  // the segment it ran) to above_mm (false: not from there, nothing sent). RT.
   bool back_out_of_grasp(Outbox& out) noexcept;
   // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
   // pinch as the bend laid it (lay, withdraw).

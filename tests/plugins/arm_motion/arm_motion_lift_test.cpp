@@ -84,6 +84,46 @@ TEST_CASE("while the hand retreats a lift straight up goes; a press, a sideways 
   CHECK(1000.0 * (end.p.z() - low.p.z()) > 29.0);
 }
 
+// The grasp's back-out (fold_sequence: an abort in the reach, the index under the far edge's
+// overhang, where straight up is into the table from below): sideways back the way it came, then
+// up, sent as kind retreat, goes while the hand retreats and runs to its end. Failing variant:
+// the same path as a plain move is refused (hand_retreat) and nothing moves.
+TEST_CASE(
+    "while the hand retreats a move of kind retreat goes back the way it came; the same as a move "
+    "does not") {
+  for (const bool as_retreat : {true, false}) {
+    CAPTURE(as_retreat);
+    Rig r;
+    for (int i = 0; i < 5; ++i) REQUIRE(r.cycle());
+    const KDL::Frame start = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+    ArmGoal in = goal_to(ToolFrame::ff_pad, shifted(start, 0, 0, -40), 1, 50, 500);
+    add_point(in, shifted(start, 0, -40, -40));
+    REQUIRE(r.cycle(&in));
+    r.run_to_end();
+    REQUIRE(r.motion->status().state == ArmMotionStatus::reached);
+    r.hand_control.mode = HandMode::retreat;  // a fingertip over force_limit_n: latched
+    r.hand_control.inhibit = HandInhibit::force_limit;
+    for (int i = 0; i < 5; ++i) r.cycle();
+    const KDL::Frame low = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+    ArmGoal back = goal_to(ToolFrame::ff_pad, shifted(start, 0, 0, -40), 2, 50, 500);
+    add_point(back, start);
+    if (as_retreat) back.kind = ArmGoal::retreat;
+    REQUIRE(r.cycle(&back));
+    for (int i = 0; i < 8000 && r.active(); ++i) r.cycle();  // the hand retreats all along
+    const KDL::Frame end = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+    if (!as_retreat) {
+      CHECK(r.motion->status().last_refused_id == 2);
+      CHECK(r.motion->status().last_refusal ==
+            static_cast<std::uint8_t>(ArmMotionReason::hand_retreat));
+      CHECK(KDL::Equal(end.p, low.p, 1e-9));
+      continue;
+    }
+    CHECK(r.motion->status().state == ArmMotionStatus::reached);
+    CHECK(r.motion->status().goal_id == 2);
+    CHECK(1000.0 * (end.p - start.p).Norm() < 1.0);  // back where it started
+  }
+}
+
 // A lift already running when the hand starts to retreat runs to its end; a motion that is
 // not a lift (the same 30 mm, 40 mm aside) decelerates and aborts as before.
 TEST_CASE("a running lift is not stopped by the hand's retreat; a running move aside is") {

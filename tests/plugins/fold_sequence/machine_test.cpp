@@ -166,29 +166,40 @@ TEST_CASE(
     }
 }
 
-TEST_CASE(
-    "an abort from the grasp's reach backs the pinching hand out the way it went in, then to "
-    "above") {
-  // half.yaml's reach: from above beyond the far edge, down to 35.5 mm under the table top, in
-  // under the overhang, up to the sheet. Lifted straight up from there the hand rose into the
-  // table from below (a trial: the index 40 mm under the top, pressing 1026 N).
+TEST_CASE("an abort from the grasp's reach backs the pinching hand out the way it went in") {
+  // half.yaml's reach: from above beyond the far edge (segment 0) down to 35.5 mm under the table
+  // top (path 0), in under the overhang (segment 1, to path 1), up to the sheet (segment 2).
+  // Lifted straight up from under the overhang the hand rose into the table from below (a
+  // trial: the index 40 mm under the top, pressing 1026 N).
   const FoldSpec f = half();
   REQUIRE(f.grasp_path_count == 2);
-  for (const S from : {S::grasp_reach, S::grasp_pinch, S::follow_via}) {
-    CAPTURE(static_cast<int>(from));
+  struct Case {
+    S from;
+    int segment;  // the pinching arm's, when the abort began (-1: its status about another goal)
+    int back;     // path points backed through before above_mm (-1: lifted straight up)
+  };
+  for (const Case c :
+       {Case{S::grasp_reach, 2, 2}, Case{S::grasp_reach, 1, 1}, Case{S::grasp_reach, 0, 0},
+        Case{S::grasp_reach, -1, 0}, Case{S::grasp_pinch, -1, 2}, Case{S::follow_via, 3, -1}}) {
+    CAPTURE(static_cast<int>(c.from));
+    CAPTURE(c.segment);
     Machine m(f);
     Memory saved = m.memory();
-    saved.leaf = from;
+    saved.leaf = c.from;
     saved.arm_has_target[kFixing] = saved.arm_has_target[kPinching] = 1;
     saved.arm_tool[kPinching] = f.grasp_tool;
+    saved.arm_id[kPinching] = 77;
     REQUIRE(m.restore(saved));
     Quiet q;
+    q.arm[kPinching].goal_id = c.segment >= 0 ? 77 : 76;
+    q.arm[kPinching].segment = static_cast<std::uint8_t>(c.segment >= 0 ? c.segment : 0);
+    q.arm[kPinching].state = ArmMotionStatus::running;
     Outbox out;
     std::int64_t now = 1'000'000;
     m.fail(Reason::force_limit);
     m.step(q.at(now), out);
     REQUIRE(m.memory().leaf == S::abort_stop);
-    CHECK(m.memory().aborted_from == from);
+    CHECK(m.memory().aborted_from == c.from);
     for (int k = 0; k < 10 && m.memory().leaf != S::abort_lift; ++k) {
       now += 30'000'000'000;  // past every timeout: stop, open
       m.step(q.at(now), out);
@@ -196,19 +207,20 @@ TEST_CASE(
     REQUIRE(m.memory().leaf == S::abort_lift);
     REQUIRE(out.arm_count[kPinching] == 1);
     REQUIRE(out.arm_count[kFixing] == 1);
-    const ArmGoal& pin = out.arm[kPinching][0];
     CHECK(out.arm[kFixing][0].frame == ArmGoal::measured);  // the fixing hand lifts
-    if (from == S::follow_via) {
+    const ArmGoal& pin = out.arm[kPinching][0];
+    if (c.back < 0) {
       CHECK(pin.frame == ArmGoal::measured);  // straight up
       CHECK(pin.point_count == 1);
       continue;
     }
     REQUIRE(pin.frame == ArmGoal::sheet);
-    REQUIRE(pin.point_count == 3);
-    for (int c = 0; c < 3; ++c) {
-      CHECK(pin.position_mm[0][c] == doctest::Approx(f.grasp_path_mm[1][c]));  // under the overhang
-      CHECK(pin.position_mm[1][c] == doctest::Approx(f.grasp_path_mm[0][c]));  // beyond the edge
-      CHECK(pin.position_mm[2][c] == doctest::Approx(f.grasp_above_mm[c]));    // above it
-    }
+    CHECK(pin.kind == ArmGoal::retreat);  // arm_motion takes it while the hand retreats
+    REQUIRE(pin.point_count == c.back + 1);
+    for (int k = 0; k < c.back; ++k)
+      for (int i = 0; i < 3; ++i)
+        CHECK(pin.position_mm[k][i] == doctest::Approx(f.grasp_path_mm[c.back - 1 - k][i]));
+    for (int i = 0; i < 3; ++i)
+      CHECK(pin.position_mm[c.back][i] == doctest::Approx(f.grasp_above_mm[i]));
   }
 }
