@@ -187,6 +187,35 @@ inline Vec3 lowest_point(const Geom& g, const Pose& pose) noexcept {
   return pose.apply(l);
 }
 
+// How far the shape reaches from its pose's origin in any direction (mm): the radius of a
+// sphere about pose.t that holds it, whatever its orientation. RT.
+inline double bounding_radius(const Geom& g) noexcept {
+  switch (g.kind) {
+    case GeomKind::sphere:
+      return g.radius_mm;
+    case GeomKind::capsule:
+      return g.radius_mm + g.half_length_mm;
+    case GeomKind::cylinder:
+      return std::hypot(g.radius_mm, g.half_length_mm);
+    case GeomKind::box:
+      return std::sqrt(g.half_mm.x * g.half_mm.x + g.half_mm.y * g.half_mm.y +
+                       g.half_mm.z * g.half_mm.z);
+  }
+  return 0;
+}
+
+// The nearest points of two shapes' cores (closest_core), by alternating projections from a's
+// centre, ITERATIONS rounds: exact for two spheres, converging for capsules and boxes' cores
+// (convex). The shapes overlap by core_grow(a) + core_grow(b) - |cb - ca|. RT.
+inline void closest_cores(const Geom& a, const Pose& pa, const Geom& b, const Pose& pb, Vec3& ca,
+                          Vec3& cb, int iterations = 4) noexcept {
+  ca = pa.t;
+  for (int it = 0; it < iterations; ++it) {
+    cb = closest_core(b, pb, ca);
+    ca = closest_core(a, pa, cb);
+  }
+}
+
 // Half the extent of the shape's bounding box along world axis a (0 x, 1 y, 2 z), from its
 // centre pose.t. RT.
 inline double half_extent(const Geom& g, const Pose& pose, int a) noexcept {

@@ -1,26 +1,8 @@
 #include "plugins/sim_world/thumb_contacts.h"
 
-#include <algorithm>
 #include <cmath>
 
 namespace crease::world {
-namespace {
-
-// How far from its pose's origin a shape reaches (mm): a bound for the pair's quick rejection.
-double reach(const Geom& g) {
-  switch (g.kind) {
-    case GeomKind::sphere:
-      return g.radius_mm;
-    case GeomKind::capsule:
-    case GeomKind::cylinder:
-      return g.radius_mm + g.half_length_mm;
-    case GeomKind::box:
-      return sheet::norm(g.half_mm);
-  }
-  return 0;
-}
-
-}  // namespace
 
 void ThumbContacts::configure(std::span<const WorldShape> shapes, double contact_area_mm2) {
   shapes_ = shapes.data();
@@ -33,7 +15,8 @@ void ThumbContacts::configure(std::span<const WorldShape> shapes, double contact
       if (!sb.compliant || sb.side != sa.side || sb.finger < 0 || sb.finger == kThumb) continue;
       const double ka = sa.stiffness_n_per_mm3 * contact_area_mm2,
                    kb = sb.stiffness_n_per_mm3 * contact_area_mm2;
-      pairs_[sa.side].push_back({a, b, ka * kb / (ka + kb), reach(sa.geom) + reach(sb.geom)});
+      pairs_[sa.side].push_back(
+          {a, b, ka * kb / (ka + kb), bounding_radius(sa.geom) + bounding_radius(sb.geom)});
     }
   }
 }
@@ -47,12 +30,8 @@ int ThumbContacts::measure_rt(int side, std::span<const Pose> poses,
     const Pose &pa = poses[p.a], &pb = poses[p.b];
     if (sheet::norm(pa.t - pb.t) > p.reach_mm + kGapMm) continue;
     const WorldShape &a = shapes_[p.a], &b = shapes_[p.b];
-    // The cores' nearest points: alternating projections from a's centre.
-    Vec3 ca = pa.t, cb;
-    for (int it = 0; it < 4; ++it) {
-      cb = closest_core(b.geom, pb, ca);
-      ca = closest_core(a.geom, pa, cb);
-    }
+    Vec3 ca, cb;
+    closest_cores(a.geom, pa, b.geom, pb, ca, cb);
     const Vec3 d = cb - ca;
     const double len = sheet::norm(d);
     const double ra = core_grow(a.geom), rb = core_grow(b.geom);

@@ -7,8 +7,8 @@
 // taxels read when its thumb presses its index, paper or not).
 //
 // Pairs: every compliant shape of the thumb with every compliant shape of another finger of the
-// same hand (configure). Geometry: the two shapes' cores' nearest points (alternating
-// projections, exact for spheres and capsules, a few tenths of a mm for a box's core), the
+// same hand (configure). Geometry: the two shapes' cores' nearest points (closest_cores,
+// shape_geometry.h), the
 // overlap of the cores grown by their radii; contacts up to kGapMm apart are listed, as the
 // sheet's are, so that the balance sees one about to close. Stiffness: both covers in series
 // over contact_area_mm2.
@@ -42,8 +42,8 @@ class ThumbContacts {
   struct Pair {
     int a = -1, b = -1;  // a: the thumb's
     double stiffness_n_per_mm = 0;
-    double reach_mm =
-        0;  // the two cores' radii and half lengths: a bound on how far apart the centres may be
+    // The two shapes' bounding radii: centres farther apart than this (and the gap) cannot touch.
+    double reach_mm = 0;
   };
   const WorldShape* shapes_ = nullptr;
   std::vector<Pair> pairs_[2];

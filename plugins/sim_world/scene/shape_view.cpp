@@ -241,22 +241,6 @@ double thickness(const Geom& g) {
                                  : 2 * g.radius_mm;
 }
 
-// The radius of the sphere about the shape's centre that holds it.
-double bounding_radius(const Geom& g) {
-  switch (g.kind) {
-    case GeomKind::sphere:
-      return g.radius_mm;
-    case GeomKind::capsule:
-      return g.radius_mm + g.half_length_mm;
-    case GeomKind::cylinder:
-      return std::hypot(g.radius_mm, g.half_length_mm);
-    case GeomKind::box:
-      return std::sqrt(g.half_mm.x * g.half_mm.x + g.half_mm.y * g.half_mm.y +
-                       g.half_mm.z * g.half_mm.z);
-  }
-  return 0;
-}
-
 }  // namespace
 
 void shapes_of(const crease::WorldShapes& in, std::vector<SceneShape>& out) {
@@ -329,7 +313,7 @@ void draw_shapes(const Camera& cam, const cv::Mat& rays, const RayBounds& bounds
                     m1 = local(sh.pose, rt * cv::Vec3d(0, 1, 0)),
                     m2 = local(sh.pose, rt * cv::Vec3d(0, 0, 1));
     // A ray that misses the shape's bounding sphere misses the shape: a cheap first test.
-    const double rb = bounding_radius(sh.geom);
+    const double rb = world::bounding_radius(sh.geom);
     const double oc = o.dot(o) - rb * rb;
     // Pixel (x, y)'s ray: where it enters the shape (camera z) and the lambertian term there.
     const auto cast = [&](int x, int y, float& s_out, float& lambert_out) {

@@ -131,3 +131,39 @@ TEST_CASE("the core's distance less core_grow bounds the distance to every kind 
     else CHECK(loosest < 1e-9);
   }
 }
+
+TEST_CASE("the bounding radius holds every kind's surface, turned") {
+  const Geom geoms[] = {{GeomKind::sphere, 4, 0, {}},
+                        {GeomKind::capsule, 2, 6, {}},
+                        {GeomKind::cylinder, 3, 5, {}},
+                        {GeomKind::box, 0, 0, {9, 7, 1}}};
+  const Pose pose = turned_x(0.7, {1, 2, 30});
+  for (const Geom& g : geoms) {
+    double farthest = 0;
+    for (int i = 0; i < 400; ++i) {
+      const double th = std::numbers::pi * (i % 20) / 19.0,
+                   ph = 2 * std::numbers::pi * (i / 20) / 20.0;
+      const Vec3 dir{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+      const SurfacePoint s = closest_surface(g, pose, pose.t + 50.0 * dir);
+      farthest = std::max(farthest, norm(s.point - pose.t));
+    }
+    CHECK(farthest <= bounding_radius(g) + 1e-9);
+    CHECK(farthest >= 0.9 * bounding_radius(g));  // not a loose bound
+  }
+}
+
+TEST_CASE("closest_cores: two crossed capsules' axes meet at their common perpendicular") {
+  // A capsule along z at the origin, one along x (turned about y) through (3, 10, -4): the
+  // axes' nearest points are (0, 0, -4) and (0, 10, -4).
+  const Geom cap{GeomKind::capsule, 2, 20, {}};
+  Pose a;
+  a.t = {0, 0, 0};
+  Pose b;
+  const double r[9] = {0, 0, 1, 0, 1, 0, -1, 0, 0};  // z -> x
+  for (int k = 0; k < 9; ++k) b.r[k] = r[k];
+  b.t = {3, 10, -4};
+  Vec3 ca, cb;
+  closest_cores(cap, a, cap, b, ca, cb);
+  check_vec(ca, {0, 0, -4}, 1e-9);
+  check_vec(cb, {0, 10, -4}, 1e-9);
+}

@@ -47,11 +47,8 @@ Closed close_pinch(WorldParams p) {
   REQUIRE(ff >= 0);
   REQUIRE(th >= 0);
   const auto &a = shapes[ff], &b = shapes[th];
-  Vec3 ca = a.pose1.t, cb;
-  for (int it = 0; it < 8; ++it) {
-    cb = crease::world::closest_core(b.geom, b.pose1, ca);
-    ca = crease::world::closest_core(a.geom, a.pose1, cb);
-  }
+  Vec3 ca, cb;
+  crease::world::closest_cores(a.geom, a.pose1, b.geom, b.pose1, ca, cb, 8);
   out.overlap_mm =
       crease::world::core_grow(a.geom) + crease::world::core_grow(b.geom) - sheet::norm(cb - ca);
   out.ff_n = rig.hand().tip[0].normal_force_n;
