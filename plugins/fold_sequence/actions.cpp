@@ -148,11 +148,16 @@ void Machine::push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) no
   m_.hand_refused0[side] = in.hand[side] != nullptr ? in.hand[side]->goals_refused : 0;
 }
 
-void Machine::hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out) noexcept {
+void Machine::hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out,
+                           const float* stiffness) noexcept {
   HandGoal g{};
   g.mode = HandMode::posture;
   g.ramp_s = static_cast<float>(spec_.posture_ramp_s);
   for (int j = 0; j < kHandJoints; ++j) g.target_rad[j] = target_rad[j];
+  if (stiffness != nullptr) {
+    g.set_stiffness = 1;
+    for (int j = 0; j < kHandJoints; ++j) g.stiffness_nm_per_rad[j] = stiffness[j];
+  }
   push_hand(side, g, in, out);
 }
 
@@ -356,7 +361,9 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::refix_approach: approach(kFixing, f.refixate, out); break;
     case S::refix_contact: descend(kFixing, f.refixate, out); break;
     case S::refix_press: hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out); break;
-    case S::swipe_release: hand_posture(kPinching, f.prepinch_rad, in, out); break;
+    case S::swipe_release:
+      hand_posture(kPinching, f.prepinch_rad, in, out, f.has_release_stiffness ? f.release_stiffness : nullptr);
+      break;
     case S::swipe_withdraw: pinch_as_laid(f.swipe_withdraw_mm, out); break;
     case S::swipe_open:
     case S::harden_open: hand_posture(kPinching, f.open_rad, in, out); break;

@@ -192,6 +192,13 @@ void read(const Params& p, FoldSpec& f) {
   std::copy(std::begin(f.open_rad), std::end(f.open_rad), std::begin(f.prepinch_rad));
   floats(h, "prepinch_rad", kHandJoints, f.prepinch_rad);
   floats(h, "pinch_rad", kHandJoints, f.pinch_rad);
+  if (h.has("release_stiffness")) {
+    floats(h, "release_stiffness", kHandJoints, f.release_stiffness);
+    for (int j = 0; j < kHandJoints; ++j)
+      if (f.release_stiffness[j] < 0.0f || f.release_stiffness[j] > 655.35f)
+        h.fail("release_stiffness", "element " + std::to_string(j) + " must be within [0, 655.35] N m/rad");
+    f.has_release_stiffness = true;
+  }
   f.posture_ramp_s = h.get_in_range<double>("ramp_s", 0.3, 0.0, 60.0);
   f.force_ramp_s = h.get_in_range<double>("force_ramp_s", 0.1, 0.0, 60.0);
 

@@ -66,6 +66,11 @@ struct FoldSpec {
   float open_rad[kHandJoints] = {};
   float prepinch_rad[kHandJoints] = {};  // shaped for the reach to the corner; open_rad when absent
   float pinch_rad[kHandJoints] = {};
+  // (f) the pinch opens at this stiffness (N m/rad per joint; has_release_stiffness false: as
+  // the hand's controller holds it): a soft thumb opening between the layers presses the stack
+  // with what its spring gives, not with a stiff joint's push past the paper.
+  float release_stiffness[kHandJoints] = {};
+  bool has_release_stiffness = false;
   double posture_ramp_s = 0.3;
   double force_ramp_s = 0.1;       // a force goal's target ramp
 

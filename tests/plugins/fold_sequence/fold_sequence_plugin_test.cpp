@@ -237,6 +237,9 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(pin_hand_after[0]->cycle > fix_force[0]->cycle);  // after the fixing press on both layers
   CHECK(pin_hand_after[0]->hand_goal.target_rad[15] == doctest::Approx(0.0));   // THJ5 open
   CHECK(pin_hand_after[0]->hand_goal.target_rad[3] == doctest::Approx(1.428));  // the index still curled
+  CHECK(pin_hand_after[0]->hand_goal.set_stiffness == 1);  // half.yaml's release_stiffness: a soft thumb
+  CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[15] == doctest::Approx(0.5));
+  CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[0] == doctest::Approx(30.0));
   const ArmGoal& withdraw = pinching[11]->arm_goal;
   CHECK(pinching[11]->cycle >= pin_hand_after[0]->cycle + r.posture_cycles);
   CHECK(near(withdraw.position_mm[0][1], 14.5));

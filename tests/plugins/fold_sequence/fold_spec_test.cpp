@@ -70,6 +70,9 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.pinch_force_n == 0.2);
   CHECK(h.prepinch_rad[3] == doctest::Approx(1.428));
   CHECK(h.pinch_rad[15] == doctest::Approx(0.77));  // THJ5 closed
+  CHECK(h.has_release_stiffness);
+  CHECK(h.release_stiffness[15] == doctest::Approx(0.5));  // the thumb soft while it opens
+  CHECK(h.release_stiffness[3] == doctest::Approx(2.0));
   REQUIRE(h.grasp_above_via_count == 1);
   CHECK(h.grasp_above_via_mm[0][2] == -300.0);
   CHECK(h.grasp_above_via_orientation[0][1] == -0.85576);
@@ -85,6 +88,7 @@ TEST_CASE("the shipped folds load") {
   CHECK(d.pinching_side == 1);  // absent: seed 000's left hand
   CHECK(d.grasp_path_count == 0);
   for (int j = 0; j < kHandJoints; ++j) CHECK(d.prepinch_rad[j] == d.open_rad[j]);  // absent: open
+  CHECK_FALSE(d.has_release_stiffness);  // absent: the controller's stiffness kept
   CHECK(d.fold_line_mm[1][0] == 210.0);
   CHECK(d.via_count == 5);
 }
@@ -174,6 +178,10 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
   SUBCASE("a prepinch posture of the wrong length") {
     const std::string e = error_of(variant("  prepinch_rad: [0, 0,", "  prepinch_rad: [0,"));
     CHECK(e.find("fold.hands.prepinch_rad: expected a list of 20 numbers") != std::string::npos);
+  }
+  SUBCASE("a negative release stiffness") {
+    const std::string e = error_of(variant("  release_stiffness: [30, 30,", "  release_stiffness: [-30, 30,"));
+    CHECK(e.find("fold.hands.release_stiffness: element 0 must be within [0, 655.35] N m/rad") != std::string::npos);
   }
   SUBCASE("a degenerate fold line") {
     const std::string e = error_of(variant("[[0, 148.5], [210, 148.5]]", "[[0, 148.5], [0.5, 148.5]]"));
