@@ -20,8 +20,9 @@
 // straight in at the pinch's height, into the hanging edge).
 // The scenes are open-loop and chaotic where the pinch holds the sheet (by one to three 7.5 mm
 // nodes): where the far edge lands moves by several mm with the last bits of the arithmetic
-// (libm's FMA and plain paths: 5.8 and 12.1 mm for the first fold, 7.9-17.7 mm for the grasp from
-// beyond over pinch points 0.5 mm apart); "folded" is within 25 mm (a dropped edge: ~290 mm).
+// (the sheet's link pass 16 or 8 links at a time, as the CPU has AVX-512 or not; libm's FMA or
+// plain path: 5.3-12.1 mm for the first fold, 7.9-20.5 mm for the grasp from beyond, over those
+// and pinch points 0.5 mm apart); "folded" is within 25 mm (a dropped edge: ~290 mm).
 // The release of the laid layer (config/folds/half.yaml's (d)-(f)) is not a test here: whether
 // the pinch still holds the layer when it is laid, and whether opening and withdrawing leave the
 // fold or drag it, turn on those bits (plugins/sim_world/README.md has the figures).
@@ -286,7 +287,8 @@ TEST_CASE("the hands fold the sheet in half: one pinches the far edge and lays i
   print("no fixation", loose);
   CHECK_FALSE(f.near_drag_mm >= 10.0);
   CHECK(loose.near_drag_mm >= 10.0);  // the pinch drags the unheld sheet after it
-  CHECK_FALSE(folded(loose));
+  // (Where its far edge then lands, 29-55 mm from the near edge over the arithmetic's variants,
+  // is too near "folded" to tell.)
 }
 
 TEST_CASE("the hand pinches the drooping far edge from beyond it, round the overhang, and folds; straight in at the pinch's height it pushes the edge away") {
