@@ -1,5 +1,6 @@
 // The machine's events, guards and fault checks: every success condition is a fact of the
 // sensing about the goal the state sent (its id echoed by the controller), never elapsed time.
+#include <algorithm>
 #include <cmath>
 
 #include "plugins/fold_sequence/machine.h"
@@ -34,6 +35,26 @@ bool for_good(std::uint8_t reason) noexcept {
     case ArmMotionReason::joint_speed: return true;
     default: return false;
   }
+}
+
+// The world point of sheet-frame point P (u, v, -h) in frame F.
+void to_world(const SheetFrame& f, const double p[3], double out[3]) noexcept {
+  for (int c = 0; c < 3; ++c) out[c] = f.origin[c] + f.x[c] * p[0] + f.y[c] * p[1] + f.z[c] * p[2];
+}
+
+// The distance from P to the segment A-B (world mm).
+double segment_distance(const double p[3], const double a[3], const double b[3]) noexcept {
+  double ab[3], ap[3];
+  for (int c = 0; c < 3; ++c) {
+    ab[c] = b[c] - a[c];
+    ap[c] = p[c] - a[c];
+  }
+  const double ll = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+  const double t =
+      ll > 0 ? std::clamp((ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / ll, 0.0, 1.0) : 0.0;
+  double d2 = 0;
+  for (int c = 0; c < 3; ++c) d2 += (ap[c] - t * ab[c]) * (ap[c] - t * ab[c]);
+  return std::sqrt(d2);
 }
 
 }  // namespace
@@ -279,7 +300,31 @@ Reason Machine::fault(const Sensing& in) noexcept {
       return found(n.arm_aborted, Reason::motion_aborted);
     }
   }
+  if (seen && pinch_lost(*sh))
+    return found("tracked grasp point off the pinch", Reason::pinch_lost);
   return Reason::none;
+}
+
+bool Machine::pinch_lost(const SheetState& sh) const noexcept {
+  // The pinching tool's way in this state: from the point it left (the grasp, or the last via
+  // point) to the one it goes to; points in the sheet frame as the tracked sheet has it now.
+  // Judged on a model state made at least kModelLagNs after the state began (the model's
+  // estimate lags vision ~0.1 s): an older one may show the point on the way before.
+  constexpr std::int64_t kModelLagNs = 150'000'000;
+  const bool lay = m_.leaf == S::layer_lay;
+  if (spec_.pinch_lost_mm <= 0 || (m_.leaf != S::follow_via && !lay) || spec_.via_count == 0 ||
+      sh.timestamp_ns < m_.leaf_since_ns + kModelLagNs)
+    return false;
+  const int k = lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count - 1);
+  const double* from = k == 0 ? spec_.grasp_at_mm : spec_.via_mm[k - 1];
+  const double* to = lay ? spec_.lay_mm : spec_.via_mm[k];
+  SheetFrame f;
+  double a[3], b[3], g[3];
+  if (!sheet_frame(sh, f) || !node_at(sh, spec_.grasp_at_mm[0], spec_.grasp_at_mm[1], g))
+    return false;
+  to_world(f, from, a);
+  to_world(f, to, b);
+  return segment_distance(g, a, b) > spec_.pinch_lost_mm;
 }
 
 }  // namespace crease::fold

@@ -28,7 +28,10 @@ double norm(const double v[3]) noexcept { return std::sqrt(v[0] * v[0] + v[1] * 
 bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept {
   if (!usable(s)) return false;
   double o[3], a[3], b[3];
-  if (!node(s, 0, 0, o) || !node(s, s.nodes_u - 1, 0, a) || !node(s, 0, s.nodes_v - 1, b)) return false;
+  // Node (0, quarter) for v, as arm_motion's frame (plugins/arm_motion/sheet_frame.h): the far
+  // corner is what a fold lifts, the half fold's crease what it loops.
+  const int quarter = std::max(1, (s.nodes_v - 1) / 4);
+  if (!node(s, 0, 0, o) || !node(s, s.nodes_u - 1, 0, a) || !node(s, 0, quarter, b)) return false;
   double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
   const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
   const double nu = norm(u);

@@ -1,7 +1,8 @@
 // What the sequence reads of the tracked sheet (sheet_state, the model's estimate, never the
 // world's truth): the sheet frame arm_motion resolves sheet-frame goals in (origin node (0, 0),
-// x along u, z = u x v, y = z x x; plugins/arm_motion/sheet_frame.h), a node's world position
-// by its sheet coordinates, and the crease nearest to a line. World mm. RT: reads a few nodes.
+// x along u, z = x cross (node (0, (H-1)/4) - origin), y = z x x;
+// plugins/arm_motion/sheet_frame.h), a node's world position by its sheet coordinates, and the
+// crease nearest to a line. World mm. RT: reads a few nodes.
 #pragma once
 
 #include "core/port_types/sheet_state.h"

@@ -166,9 +166,10 @@ constexpr bool rows_in_order() {
 static_assert(rows_in_order(), "kRows are grouped by state in S's order");
 
 constexpr const char* kReasonNames[] = {
-    "none",        "started",      "condition",      "timeout",        "device_fault",
-    "vision_lost", "force_limit",  "unreachable",    "goal_refused",   "motion_aborted",
-    "slide_out_of_range", "no_sheet", "command_lost", "operator_abort", "no_contact",
+    "none",         "started",        "condition",          "timeout",
+    "device_fault", "vision_lost",    "force_limit",        "unreachable",
+    "goal_refused", "motion_aborted", "slide_out_of_range", "no_sheet",
+    "command_lost", "operator_abort", "no_contact",         "pinch_lost",
 };
 static_assert(sizeof(kReasonNames) / sizeof(kReasonNames[0]) == static_cast<std::size_t>(Reason::count));
 

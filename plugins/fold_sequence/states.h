@@ -75,19 +75,20 @@ enum class Guard : std::uint8_t {
 enum class Reason : std::uint8_t {
   none,
   started,
-  condition,         // the row's event (its `why` text)
+  condition,  // the row's event (its `why` text)
   timeout,
-  device_fault,      // a controller's status stale, a hand or arm fault, contact_state unhealthy
-  vision_lost,       // sheet_state stale or without observations longer than the bound
-  force_limit,       // a fingertip over the force controller's limit
-  unreachable,       // arm_motion refused a goal as unreachable (or its joint speed)
-  goal_refused,      // arm_motion or a force controller refused a goal for another reason
-  motion_aborted,    // arm_motion aborted the state's motion
+  device_fault,    // a controller's status stale, a hand or arm fault, contact_state unhealthy
+  vision_lost,     // sheet_state stale or without observations longer than the bound
+  force_limit,     // a fingertip over the force controller's limit
+  unreachable,     // arm_motion refused a goal as unreachable (or its joint speed)
+  goal_refused,    // arm_motion or a force controller refused a goal for another reason
+  motion_aborted,  // arm_motion aborted the state's motion
   slide_out_of_range,
-  no_sheet,          // a state needed the sheet's pose and there was none
-  command_lost,      // a command queue was full
+  no_sheet,      // a state needed the sheet's pose and there was none
+  command_lost,  // a command queue was full
   operator_abort,
-  no_contact,        // a contact descent reached its depth (below the surface) without a contact
+  no_contact,  // a contact descent reached its depth (below the surface) without a contact
+  pinch_lost,  // the tracked grasp point left the pinching tool's way (bend, lay)
   count
 };
 [[nodiscard]] const char* reason_name(Reason r) noexcept;

@@ -328,6 +328,29 @@ TEST_CASE("the pinch is felt: a closing whose pads squeeze nothing holds grasp/p
   expect_abort(s, crease::fold::Reason::timeout);
 }
 
+TEST_CASE(
+    "the pinch lost in the bend: the tracked grasp point left behind aborts with pinch_lost") {
+  // The third via point's motion runs long (never reached). Failing variant first: the tracked
+  // grasp point went where the pinch took it (the second via point, on the way): the bend goes on.
+  const auto stall_via2 = [](int side, const ArmGoal& g, int) {
+    return side == kPin && g.frame == ArmGoal::sheet && near(g.position_mm[0][1], 206.8);
+  };
+  Rig r;
+  r.stalls = stall_via2;
+  start_and_run_to(r, "fold/bend/follow_via[2]");
+  r.run(3000);
+  CHECK(std::string(r.status().path) == "fold/bend/follow_via[2]");
+  CHECK(r.status().phase != SequenceStatus::aborted);
+  // Lost: the point stays on the table by the far edge, 73 mm from the way up (50 allowed).
+  Rig s;
+  s.stalls = stall_via2;
+  s.pinch_carries = false;
+  s.command(Command::start);
+  REQUIRE(s.run_to("fold/bend/follow_via[2]"));
+  expect_abort(s, crease::fold::Reason::pinch_lost);
+  CHECK(s.paths()[s.paths().size() - 1 - kRetreat.size()] == "fold/bend/follow_via[2]");
+}
+
 TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {
   using crease::fold::Reason;
   SUBCASE("device fault: the arm's drive faults during a motion") {

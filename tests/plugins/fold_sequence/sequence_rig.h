@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -21,6 +22,7 @@
 #include "core/port_registry.h"
 #include "core/port_types/sequence_status.h"
 #include "plugins/fold_sequence/fold_sequence_plugin.h"
+#include "plugins/fold_sequence/sheet_geometry.h"
 #include "rt/alloc_guard.h"
 
 namespace rig {
@@ -174,6 +176,7 @@ class Rig {
   int posture_cycles = 10;    // a posture ramps this long
   std::uint32_t observations = 12;  // per sheet_state
   bool sheet_live = true;     // false: sheet_state no longer written (stale)
+  bool pinch_carries = true;  // false: the pinch's goals leave the sheet where it lies (carry())
   // Per arm goal (side, goal, index of the side's move goals): refuse as unreachable / never end.
   std::function<bool(int, const ArmGoal&, int)> unreachable = [](int, const ArmGoal&, int) { return false; };
   std::function<bool(int, const ArmGoal&, int)> stalls = [](int, const ArmGoal&, int) { return false; };
@@ -208,6 +211,25 @@ class Rig {
     bool pinch = false;
   };
 
+  // A sheet-frame goal reached by a closed pinch takes the pinched node along (the node
+  // nearest the goal's u, v when the pinch first carries): the tracked grasp point follows the
+  // pinch as the model would (pinch_carries false: it stays, as after a lost pinch).
+  void carry(int s, const ArmGoal& g) {
+    if (!pinch_carries || !hands_[s].pinch || g.frame != ArmGoal::sheet || g.point_count == 0)
+      return;
+    const double* p = g.position_mm[g.point_count - 1];
+    crease::fold::SheetFrame f;
+    if (!crease::fold::sheet_frame(*sheet_, f)) return;
+    if (carried_ < 0)
+      carried_ = static_cast<int>(std::lround(std::clamp(p[1] / 148.5, 0.0, 2.0))) * 3 +
+                 static_cast<int>(std::lround(std::clamp(p[0] / 105.0, 0.0, 2.0)));
+    for (int c = 0; c < 3; ++c)
+      sheet_->position_mm[carried_][c] =
+          static_cast<float>(f.origin[c] + f.x[c] * p[0] + f.y[c] * p[1] + f.z[c] * p[2]);
+    carried_new_ =
+        true;  // published this cycle: the rig's motions are shorter than the model's period
+  }
+
   void answer() {
     for (int s = 0; s < 2; ++s) {
       Arm& a = arms_[s];
@@ -226,6 +248,7 @@ class Rig {
             ++contact_[s].onsets;
           } else {
             a.st.state = ArmMotionStatus::reached;
+            carry(s, a.goal);
           }
         }
       }
@@ -253,7 +276,8 @@ class Rig {
       hand_out_[s].write(h.st, now_);
       contact_out_[s].write(contact_[s], now_);
     }
-    if (sheet_live && n_ % 16 == 0) {  // the model's 60 Hz, about
+    if (sheet_live && (n_ % 16 == 0 || carried_new_)) {  // the model's 60 Hz, about
+      carried_new_ = false;
       sheet_->timestamp_ns = now_;
       ++sheet_->step;
       sheet_->observations = observations;
@@ -369,6 +393,8 @@ class Rig {
   PortBinder rig_ports_{registry_, "rig", {}, &flags_, nullptr};
   std::unique_ptr<FoldSequencePlugin> plugin_;
   std::unique_ptr<SheetState> sheet_;
+  int carried_ = -1;  // the node the pinch carries (carry()); -1: none yet
+  bool carried_new_ = false;
   LatestOutput<ArmMotionStatus> arm_out_[2];
   LatestOutput<HandControlStatus> hand_out_[2];
   LatestOutput<ContactState> contact_out_[2];

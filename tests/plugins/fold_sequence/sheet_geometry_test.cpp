@@ -52,6 +52,23 @@ TEST_CASE("the sheet frame: origin at node (0, 0), x along u, z = u x v into the
   CHECK(p[0] == doctest::Approx(-105 + std::cos(yaw) * 52.5 + std::sin(yaw) * 49.5).epsilon(1e-6));
 }
 
+TEST_CASE(
+    "the frame takes v a quarter along the edge, as arm_motion's: the far corner a fold lifts does "
+    "not tilt it") {
+  auto s = sheet(5, 9, -105, 148.5, 0);
+  for (int i = 0; i < 5; ++i)
+    s->position_mm[8 * 5 + i][2] = -120;  // the far edge carried up and over
+  s->position_mm[4 * 5][2] = -30;         // the half fold's crease, looped
+  SheetFrame f;
+  REQUIRE(sheet_frame(*s, f));
+  CHECK(f.z[2] == doctest::Approx(-1));
+  CHECK(f.y[1] == doctest::Approx(-1));
+  // Failing variant: with node (0, 2) (a quarter along) lifted, the frame tilts.
+  s->position_mm[2 * 5][2] = -30;
+  REQUIRE(sheet_frame(*s, f));
+  CHECK(f.z[2] > -0.95);  // 22 deg
+}
+
 TEST_CASE("degenerate sheets have no frame") {
   auto s = sheet(3, 3, 0, 0, 0);
   s->position_mm[2][0] = s->position_mm[0][0];  // node (W-1, 0) on the origin
