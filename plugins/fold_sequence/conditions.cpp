@@ -306,25 +306,31 @@ Reason Machine::fault(const Sensing& in) noexcept {
 }
 
 bool Machine::pinch_lost(const SheetState& sh) const noexcept {
-  // The pinching tool's way in this state: from the point it left (the grasp, or the last via
-  // point) to the one it goes to; points in the sheet frame as the tracked sheet has it now.
-  // Judged on a model state made at least kModelLagNs after the state began (the model's
-  // estimate lags vision ~0.1 s): an older one may show the point on the way before.
+  // The pinching tool's way in this state and the one before it: from the point before the one
+  // it left, through the point it left (the grasp, or a via point), to the one it goes to; in the
+  // sheet frame as the tracked sheet has it now. The way before too because the model's flap,
+  // the hand hiding it from the cameras, lags the pinch by up to a segment (a trial: 47 mm behind
+  // 0.3 s into follow_via[3], the pinch holding). Judged on a model state made at least
+  // kModelLagNs after the state began.
   constexpr std::int64_t kModelLagNs = 150'000'000;
   const bool lay = m_.leaf == S::layer_lay;
   if (spec_.pinch_lost_mm <= 0 || (m_.leaf != S::follow_via && !lay) || spec_.via_count == 0 ||
       sh.timestamp_ns < m_.leaf_since_ns + kModelLagNs)
     return false;
-  const int k = lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count - 1);
-  const double* from = k == 0 ? spec_.grasp_at_mm : spec_.via_mm[k - 1];
-  const double* to = lay ? spec_.lay_mm : spec_.via_mm[k];
+  const int k =
+      lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count - 1);  // the point it goes to
+  const auto point = [&](int i) {
+    return i < 0 ? spec_.grasp_at_mm : i < spec_.via_count ? spec_.via_mm[i] : spec_.lay_mm;
+  };
   SheetFrame f;
-  double a[3], b[3], g[3];
+  double g[3], w[3][3];
   if (!sheet_frame(sh, f) || !node_at(sh, spec_.grasp_at_mm[0], spec_.grasp_at_mm[1], g))
     return false;
-  to_world(f, from, a);
-  to_world(f, to, b);
-  return segment_distance(g, a, b) > spec_.pinch_lost_mm;
+  const int first = std::max(-1, k - 2);
+  for (int i = first; i <= k; ++i) to_world(f, point(i), w[i - first]);
+  double d = segment_distance(g, w[k - 1 - first], w[k - first]);
+  if (k - first == 2) d = std::min(d, segment_distance(g, w[0], w[1]));
+  return d > spec_.pinch_lost_mm;
 }
 
 }  // namespace crease::fold

@@ -49,6 +49,16 @@ bool near(double a, double b, double tol = 1e-3) { return std::abs(a - b) <= tol
 // After an abort: both hands' last goal opens them (posture, the fold's open targets: zeros),
 // no force goal reached a hand after the abort began, both arms were stopped and parked.
 void check_retreat(const Rig& r, long abort_cycle) {
+  // The state the abort came from: with the pinch turned by the bend, its hand lifts 150 mm.
+  const auto& paths = r.paths();
+  const auto stop = std::find(paths.rbegin(), paths.rend(), "abort/stop");
+  REQUIRE(stop != paths.rend());
+  REQUIRE(stop + 1 != paths.rend());
+  const std::string from = *(stop + 1);
+  bool turned = false;
+  for (const char* p : {"fold/bend/follow", "fold/bend/crease", "fold/fixate_layer/",
+                        "fold/refixate/", "fold/swipe/release", "fold/swipe/withdraw"})
+    turned = turned || from.rfind(p, 0) == 0;
   for (int s = 0; s < 2; ++s) {
     CAPTURE(s);
     const Sent* h = r.last(s, Sent::hand);
@@ -62,7 +72,8 @@ void check_retreat(const Rig& r, long abort_cycle) {
     CHECK(arm.back()->arm_goal.kind == ArmGoal::move);
     CHECK(arm.back()->arm_goal.frame == ArmGoal::world);  // parked
     CHECK(arm.back()->arm_goal.position_mm[0][2] == 300.0);
-    // An arm that had moved lifts first: straight up by release_lift_mm from where it is
+    // An arm that had moved lifts first: straight up by release_lift_mm (the pinching one turned
+    // by the bend park_lift_mm) from where it is
     // measured (arm_motion's `measured` frame, the orientation kept), not from its last target;
     // the pinching one aborted in the grasp's reach or pinch backs out along the reach path to
     // above_mm instead (half.yaml: two points back, then [105, 338.5, 39.5] in the sheet frame).
@@ -80,7 +91,7 @@ void check_retreat(const Rig& r, long abort_cycle) {
       CHECK(g.frame == ArmGoal::measured);
       CHECK(g.position_mm[0][0] == 0.0);
       CHECK(g.position_mm[0][1] == 0.0);
-      CHECK(g.position_mm[0][2] == 30.0);
+      CHECK(g.position_mm[0][2] == (s == kPin && turned ? 150.0 : 30.0));
       CHECK(g.orientation[0][3] == 1.0);
     }
   }
@@ -330,25 +341,27 @@ TEST_CASE("the pinch is felt: a closing whose pads squeeze nothing holds grasp/p
 
 TEST_CASE(
     "the pinch lost in the bend: the tracked grasp point left behind aborts with pinch_lost") {
-  // The third via point's motion runs long (never reached). Failing variant first: the tracked
-  // grasp point went where the pinch took it (the second via point, on the way): the bend goes on.
-  const auto stall_via2 = [](int side, const ArmGoal& g, int) {
-    return side == kPin && g.frame == ArmGoal::sheet && near(g.position_mm[0][1], 206.8);
+  // The fourth via point's motion runs long (never reached). Failing variant first: the tracked
+  // grasp point went where the pinch took it (the third via point, on the way): the bend goes on.
+  const auto stall_via3 = [](int side, const ArmGoal& g, int) {
+    return side == kPin && g.frame == ArmGoal::sheet && near(g.position_mm[0][1], 148.5) &&
+           g.position_mm[0][2] < -100;
   };
   Rig r;
-  r.stalls = stall_via2;
-  start_and_run_to(r, "fold/bend/follow_via[2]");
+  r.stalls = stall_via3;
+  start_and_run_to(r, "fold/bend/follow_via[3]");
   r.run(3000);
-  CHECK(std::string(r.status().path) == "fold/bend/follow_via[2]");
+  CHECK(std::string(r.status().path) == "fold/bend/follow_via[3]");
   CHECK(r.status().phase != SequenceStatus::aborted);
-  // Lost: the point stays on the table by the far edge, 73 mm from the way up (50 allowed).
+  // Lost: the point stays on the table by the far edge, 73 mm from the way up since the second
+  // via point (50 allowed; the way before it passes 25 mm from the edge).
   Rig s;
-  s.stalls = stall_via2;
+  s.stalls = stall_via3;
   s.pinch_carries = false;
   s.command(Command::start);
-  REQUIRE(s.run_to("fold/bend/follow_via[2]"));
+  REQUIRE(s.run_to("fold/bend/follow_via[3]"));
   expect_abort(s, crease::fold::Reason::pinch_lost);
-  CHECK(s.paths()[s.paths().size() - 1 - kRetreat.size()] == "fold/bend/follow_via[2]");
+  CHECK(s.paths()[s.paths().size() - 1 - kRetreat.size()] == "fold/bend/follow_via[3]");
 }
 
 TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {
