@@ -78,25 +78,6 @@ void Machine::arm_stop(int side, Outbox& out) noexcept {
   m_.arm_id[side] = 0;  // a stop is not waited for by id: the arm is still when it no longer moves
 }
 
-bool turned_by_bend(S s) noexcept {
-  switch (s) {
-    case S::bend_crease:
-    case S::follow_via:
-    case S::layer_lay:
-    case S::refix_slide_out:
-    case S::refix_open:
-    case S::refix_lift:
-    case S::refix_approach:
-    case S::refix_contact:
-    case S::refix_press:
-    case S::swipe_release:
-    case S::swipe_withdraw:
-      return true;
-    default:
-      return false;
-  }
-}
-
 void Machine::arm_lift(int side, double lift_mm, Outbox& out) noexcept {
   if (!m_.arm_has_target[side]) return;  // never moved: where it parked
   // Straight up from where the tool is measured to be (arm_motion's `measured` frame), not from
@@ -448,14 +429,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       break;
     case S::abort_lift:
       arm_lift(kFixing, f.release_lift_mm, out);
-      // A pinch turned by the bend lifts park_lift_mm: the park's line turns the hand back to
-      // palm down, which swept the little finger from a 30 mm lift into the table (a trial,
-      // abort in follow_via[3]: 17.7 N, the park timed out, hands_clear 0).
-      if (!back_out_of_grasp(out))
-        arm_lift(kPinching,
-                 turned_by_bend(m_.aborted_from) ? std::max(f.release_lift_mm, f.park_lift_mm)
-                                                 : f.release_lift_mm,
-                 out);
+      if (!back_out_of_grasp(out)) arm_lift(kPinching, f.release_lift_mm, out);
       break;
     case S::finish_park:
     case S::abort_park:

@@ -90,10 +90,6 @@ struct Outbox {
 
 enum class Command : std::uint8_t { none = 0, start = 1, pause = 2, resume = 3, abort = 4, step = 5 };
 
-// The states in which the pinching hand is turned by the bend (from the crease to the pinch's
-// withdrawal): an abort from them lifts it park_lift_mm before the park.
-[[nodiscard]] bool turned_by_bend(S s) noexcept;
-
 struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
