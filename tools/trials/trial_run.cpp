@@ -13,6 +13,7 @@
 
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
+#include "core/port_types/contact.h"
 #include "core/port_types/hand_control.h"
 #include "core/port_types/sequence_status.h"
 #include "core/port_types/sheet_state.h"
@@ -161,6 +162,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     const std::string status_name = port_of(cfg, fold, "sequence_status");
     // The hands' force controllers' status, as the sequence reads it.
     const std::string hand_status_name[2] = {port_of(cfg, fold, "hand_r_status"), port_of(cfg, fold, "hand_l_status")};
+    const std::string contact_name[2] = {port_of(cfg, fold, "contact_r_state"),
+                                         port_of(cfg, fold, "contact_l_state")};
 
     daemon::Options opts;
     opts.plugin_dirs = o.plugin_dirs;
@@ -174,6 +177,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     auto world_state = reader<WorldState>(host, "world_state");
     std::unique_ptr<rt::LatestReader<HandControlStatus>> hand_status[2] = {
         reader<HandControlStatus>(host, hand_status_name[0]), reader<HandControlStatus>(host, hand_status_name[1])};
+    std::unique_ptr<rt::LatestReader<ContactState>> contact_state[2] = {
+        reader<ContactState>(host, contact_name[0]), reader<ContactState>(host, contact_name[1])};
     auto truth = reader<SheetState>(host, "sheet_truth");
     auto reference = std::make_unique<SheetState>();
     bool have_reference = false;
@@ -221,12 +226,19 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
         if (started_ns != 0 && rt::now_ns() - sampled_ns >= static_cast<std::int64_t>(kSeriesS * 1e9)) {
           sampled_ns = rt::now_ns();
           const double stretch = truth->poll().has_data() ? max_stretch(truth->value()) : std::nan("");
-          r.series.push_back({since(started_ns),
-                              {window_force[0], window_force[1]},
-                              stretch,
-                              {window_measured[0], window_measured[1]},
-                              {window_tip[0], window_tip[1]},
-                              {window_tip_z[0], window_tip_z[1]}});
+          SeriesSample x{since(started_ns),
+                         {window_force[0], window_force[1]},
+                         stretch,
+                         {window_measured[0], window_measured[1]},
+                         {window_tip[0], window_tip[1]},
+                         {window_tip_z[0], window_tip_z[1]}};
+          for (int h = 0; h < 2; ++h)
+            if (contact_state[h]->poll().has_data()) {
+              const ContactState& c = contact_state[h]->value();
+              x.contact_fingers[h] = c.in_contact != 0 ? c.fingers : 0;
+              x.contact_onsets[h] = static_cast<long>(c.onsets);
+            }
+          r.series.push_back(x);
           window_force[0] = window_force[1] = 0;
           window_tip[0] = window_tip[1] = -1;
           window_tip_z[0] = window_tip_z[1] = std::nan("");
@@ -366,7 +378,9 @@ nlohmann::json to_json(const TrialResult& r) {
       {"force_l_n", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
       {"measured_r_n", nlohmann::json::array()}, {"measured_l_n", nlohmann::json::array()},
       {"tip_r", nlohmann::json::array()},        {"tip_l", nlohmann::json::array()},
-      {"tip_r_z_mm", nlohmann::json::array()},   {"tip_l_z_mm", nlohmann::json::array()}};
+      {"tip_r_z_mm", nlohmann::json::array()},   {"tip_l_z_mm", nlohmann::json::array()},
+      {"contact_r", nlohmann::json::array()},    {"contact_l", nlohmann::json::array()},
+      {"onsets_r", nlohmann::json::array()},     {"onsets_l", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -382,6 +396,10 @@ nlohmann::json to_json(const TrialResult& r) {
     series["tip_l"].push_back(x.force_tip[1]);
     series["tip_r_z_mm"].push_back(num(x.force_tip_z_mm[0]));
     series["tip_l_z_mm"].push_back(num(x.force_tip_z_mm[1]));
+    series["contact_r"].push_back(x.contact_fingers[0]);
+    series["contact_l"].push_back(x.contact_fingers[1]);
+    series["onsets_r"].push_back(x.contact_onsets[0]);
+    series["onsets_l"].push_back(x.contact_onsets[1]);
   }
   const Score& s = r.score;
   return {{"trial", r.index},
@@ -472,6 +490,12 @@ TrialResult from_json(const nlohmann::json& j) {
         v.force_tip[1] = x.at("tip_l")[k].get<int>();
         v.force_tip_z_mm[0] = num(x.at("tip_r_z_mm")[k]);
         v.force_tip_z_mm[1] = num(x.at("tip_l_z_mm")[k]);
+      }
+      if (x.contains("contact_r")) {
+        v.contact_fingers[0] = x.at("contact_r")[k].get<int>();
+        v.contact_fingers[1] = x.at("contact_l")[k].get<int>();
+        v.contact_onsets[0] = x.at("onsets_r")[k].get<long>();
+        v.contact_onsets[1] = x.at("onsets_l")[k].get<long>();
       }
       r.series.push_back(v);
     }

@@ -58,6 +58,11 @@ struct SeriesSample {
   int force_tip[2] = {-1, -1};
   double force_tip_z_mm[2] = {std::numeric_limits<double>::quiet_NaN(),
                               std::numeric_limits<double>::quiet_NaN()};
+  // Each hand's contact detector (contact_state) at the sample: the fingers it has in contact
+  // (bit f, 0: out of contact; -1: no state yet) and its onsets so far (a contact descent stops
+  // on a new one).
+  int contact_fingers[2] = {-1, -1};
+  long contact_onsets[2] = {-1, -1};
 };
 inline constexpr double kSeriesS = 0.02;
 

@@ -262,7 +262,14 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(row(b).find("why=\"aborted in fold/shift/approach: device_fault; sheet: no fold") != std::string::npos);
   CHECK(row(a).find("success=1") != std::string::npos);
   // The JSON round trip keeps what the table shows.
-  b.series.push_back({0.5, {1.5, 2.0}, 0.02, {1.4, std::nan("")}, {4, -1}, {12.5, std::nan("")}});
+  b.series.push_back({0.5,
+                      {1.5, 2.0},
+                      0.02,
+                      {1.4, std::nan("")},
+                      {4, -1},
+                      {12.5, std::nan("")},
+                      {0x11, -1},
+                      {3, -1}});
   b.score.stretch_at_mm[0] = 52.5;
   b.score.stretch_at_mm[1] = 7.425;
   b.sheet_nodes_u = 2;
@@ -287,4 +294,10 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(back.series[0].force_tip[1] == -1);
   CHECK(back.series[0].force_tip_z_mm[0] == 12.5);
   CHECK(std::isnan(back.series[0].force_tip_z_mm[1]));
+  // ... and each hand's contact detector: the right in contact at th and ff after 3 onsets, the
+  // left without a state yet.
+  CHECK(back.series[0].contact_fingers[0] == 0x11);
+  CHECK(back.series[0].contact_onsets[0] == 3);
+  CHECK(back.series[0].contact_fingers[1] == -1);
+  CHECK(back.series[0].contact_onsets[1] == -1);
 }
