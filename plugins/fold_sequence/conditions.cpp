@@ -37,11 +37,6 @@ bool for_good(std::uint8_t reason) noexcept {
   }
 }
 
-// The world point of sheet-frame point P (u, v, -h) in frame F.
-void to_world(const SheetFrame& f, const double p[3], double out[3]) noexcept {
-  for (int c = 0; c < 3; ++c) out[c] = f.origin[c] + f.x[c] * p[0] + f.y[c] * p[1] + f.z[c] * p[2];
-}
-
 // The distance from P to the segment A-B (world mm).
 double segment_distance(const double p[3], const double a[3], const double b[3]) noexcept {
   double ab[3], ap[3];
@@ -327,7 +322,7 @@ bool Machine::pinch_lost(const SheetState& sh) const noexcept {
   if (!sheet_frame(sh, f) || !node_at(sh, spec_.grasp_at_mm[0], spec_.grasp_at_mm[1], g))
     return false;
   const int first = std::max(-1, k - 2);
-  for (int i = first; i <= k; ++i) to_world(f, point(i), w[i - first]);
+  for (int i = first; i <= k; ++i) sheet_to_world(f, point(i), w[i - first]);
   double d = segment_distance(g, w[k - 1 - first], w[k - first]);
   if (k - first == 2) d = std::min(d, segment_distance(g, w[0], w[1]));
   return d > spec_.pinch_lost_mm;

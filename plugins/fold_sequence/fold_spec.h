@@ -50,8 +50,8 @@ struct FoldSpec {
 
   // Sensing bounds.
   // The pinch lost (bend and lay): the tracked sheet's grasp point (the node nearest grasp.at_mm's
-  // u, v) further than this (mm) from the pinching tool's way through the state's points
-  // (the last one reached to the next, in the sheet frame now). 0: not checked.
+  // u, v) further than this (mm) from the pinching tool's way in the state and the one before
+  // (Machine::pinch_lost). 0: not checked.
   double pinch_lost_mm = 0;
   double vision_lost_max_s = 0.5;   // sheet_state stale, or fewer than min_observations, this long: abort
   std::uint32_t min_observations = 1;

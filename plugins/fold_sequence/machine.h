@@ -177,8 +177,8 @@ class Machine {
   [[nodiscard]] bool holds(Ev ev, S owner, const Sensing& in) const noexcept;
   [[nodiscard]] bool passes(Guard g, const Sensing& in) const noexcept;
   [[nodiscard]] Reason fault(const Sensing& in) noexcept;  // Reason::none when all is well
-  [[nodiscard]] bool pinch_lost(
-      const SheetState& sh) const noexcept;  // spec_.pinch_lost_mm's check
+  // spec_.pinch_lost_mm's check on the tracked sheet SH (conditions.cpp).
+  [[nodiscard]] bool pinch_lost(const SheetState& sh) const noexcept;
   [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2]) const noexcept;
   // actions.cpp: entry and exit actions, the goals.
   void enter(S s, const Sensing& in, Outbox& out) noexcept;

@@ -25,6 +25,10 @@ double norm(const double v[3]) noexcept { return std::sqrt(v[0] * v[0] + v[1] * 
 
 }  // namespace
 
+void sheet_to_world(const SheetFrame& f, const double p[3], double out[3]) noexcept {
+  for (int c = 0; c < 3; ++c) out[c] = f.origin[c] + f.x[c] * p[0] + f.y[c] * p[1] + f.z[c] * p[2];
+}
+
 bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept {
   if (!usable(s)) return false;
   double o[3], a[3], b[3];

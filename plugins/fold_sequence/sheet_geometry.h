@@ -16,6 +16,8 @@ struct SheetFrame {
 
 // False for a state with fewer than 2 x 2 nodes, non-finite corners or degenerate edges.
 [[nodiscard]] bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept;
+// The world position of sheet-frame point P (u, v, -h: a fold file's point) in frame F.
+void sheet_to_world(const SheetFrame& f, const double p[3], double out[3]) noexcept;
 // The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
 [[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
 // The crease of s nearest to the segment a-b (sheet mm, by the sum of its end points'

@@ -223,9 +223,9 @@ class Rig {
     if (carried_ < 0)
       carried_ = static_cast<int>(std::lround(std::clamp(p[1] / 148.5, 0.0, 2.0))) * 3 +
                  static_cast<int>(std::lround(std::clamp(p[0] / 105.0, 0.0, 2.0)));
-    for (int c = 0; c < 3; ++c)
-      sheet_->position_mm[carried_][c] =
-          static_cast<float>(f.origin[c] + f.x[c] * p[0] + f.y[c] * p[1] + f.z[c] * p[2]);
+    double w[3];
+    crease::fold::sheet_to_world(f, p, w);
+    for (int c = 0; c < 3; ++c) sheet_->position_mm[carried_][c] = static_cast<float>(w[c]);
     carried_new_ =
         true;  // published this cycle: the rig's motions are shorter than the model's period
   }

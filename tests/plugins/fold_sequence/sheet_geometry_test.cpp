@@ -50,6 +50,12 @@ TEST_CASE("the sheet frame: origin at node (0, 0), x along u, z = u x v into the
   CHECK(p[0] == doctest::Approx(-105 + std::cos(yaw) * 210 + std::sin(yaw) * 297).epsilon(1e-6));
   REQUIRE(node_at(*s, 52, 50, p));  // the nearest node: (1, 1) at u 52.5, v 49.5
   CHECK(p[0] == doctest::Approx(-105 + std::cos(yaw) * 52.5 + std::sin(yaw) * 49.5).epsilon(1e-6));
+  // A fold file's point (u, v, -h) in the frame: the node itself at h 0, h above it along -z.
+  const double at[3] = {52.5, 49.5, -20}, node11[3] = {p[0], p[1], p[2]};
+  sheet_to_world(f, at, p);
+  CHECK(p[0] == doctest::Approx(node11[0]).epsilon(1e-6));
+  CHECK(p[1] == doctest::Approx(node11[1]).epsilon(1e-6));
+  CHECK(p[2] == doctest::Approx(20.0));
 }
 
 TEST_CASE(
