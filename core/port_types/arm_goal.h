@@ -48,7 +48,8 @@ struct ArmGoal {
   enum StopOn : std::uint8_t {
     stop_none = 0,
     contact_onset = 1,  // contact_state reports a new onset (its `onsets` counter rose since the
-                        // motion started) with a finger of stop_fingers in contact
+                        // motion started) with a finger of stop_fingers in contact, or a finger
+                        // of stop_fingers joins a contact held since the motion started
   };
 
   std::int64_t timestamp_ns = 0;

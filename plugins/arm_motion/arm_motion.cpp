@@ -185,6 +185,9 @@ void ArmMotion::on_goal(const ArmGoal& g, const CycleInputs& in, const KDL::Fram
   s_.stop_fingers = g.stop_fingers;
   s_.lift = lift ? 1 : 0;
   s_.onsets_at_start = in.contact != nullptr ? in.contact->onsets : 0;
+  s_.stop_fingers_held = in.contact != nullptr && in.contact->in_contact != 0
+                             ? static_cast<std::uint8_t>(in.contact->fingers & g.stop_fingers)
+                             : 0;
   s_.check_segment = 0;
   s_.check_sigma = 0;
   std::memcpy(s_.q_check, s_.q_cmd, sizeof(s_.q_check));
@@ -280,8 +283,16 @@ void ArmMotion::run(const CycleInputs& in) noexcept {
   } else if (s_.phase == ArmMotionStatus::running && s_.stop_on == ArmGoal::contact_onset) {
     if (!contact_fresh(in)) {
       begin_stop(ArmMotionStatus::aborted, ArmMotionReason::contact_stale);
-    } else if (in.contact->onsets > s_.onsets_at_start && (in.contact->fingers & s_.stop_fingers) != 0) {
-      begin_stop(ArmMotionStatus::stopped_on_contact, ArmMotionReason::none);
+    } else {
+      // A new onset with a stop finger in contact; or, the hand held in contact since before the
+      // start (a detector whose joints read off their reference after the hand's posture changed
+      // while it pressed raises no new onset), a stop finger joining that contact.
+      const ContactState& c = *in.contact;
+      if (c.in_contact == 0) s_.stop_fingers_held = 0;
+      const bool onset = c.onsets > s_.onsets_at_start && (c.fingers & s_.stop_fingers) != 0;
+      const bool joined =
+          c.in_contact != 0 && (c.fingers & s_.stop_fingers & ~s_.stop_fingers_held) != 0;
+      if (onset || joined) begin_stop(ArmMotionStatus::stopped_on_contact, ArmMotionReason::none);
     }
   }
   speed_m_s_ = step_profile(s_.path, s_.profile, in.dt_s);

@@ -111,6 +111,7 @@ struct MotionState {
   std::uint8_t tool = 0;
   std::uint8_t stop_on = 0;
   std::uint8_t stop_fingers = 0;
+  std::uint8_t stop_fingers_held = 0;  // of stop_fingers, those in a contact held since the start
   std::uint8_t lift = 0;        // a lift (goal_check.h): the hand's retreat does not stop it
   std::uint8_t joint_move = 0;  // the motion is a joints goal's (joint), not the path's
   std::uint8_t have_home = 0;

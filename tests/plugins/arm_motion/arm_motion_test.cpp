@@ -265,6 +265,52 @@ TEST_CASE("a contact onset stops the motion in the same cycle, decelerating with
   }
 }
 
+// The contact detector can hold a contact with no new onset: a trial's fixing hand, lifted off
+// the table after pressing, read lf and th in contact (its joints off their reference in the new
+// pose), so the refixating descent's index touch raised no onset and the descent went to its depth
+// (abort no_contact). A stop finger joining the held contact is the touch; stop fingers already in
+// it at the start are not (the variant: the index held from the start goes on).
+TEST_CASE(
+    "a descent begun while other fingers hold a contact stops when a stop finger joins it, not on "
+    "fingers held from the start") {
+  for (const bool index_held : {false, true}) {
+    CAPTURE(index_held);
+    Rig r;
+    r.contact.onsets = 1;
+    r.contact.in_contact = 1;
+    r.contact.fingers = index_held ? 0x19 : 0x18;  // lf and th (and the index)
+    idle(r);
+    const KDL::Frame start = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+    ArmGoal g = goal_to(ToolFrame::ff_pad, shifted(start, 0, 0, -60), 3, 50, 500);
+    g.stop_on = ArmGoal::contact_onset;
+    g.stop_accel_mm_s2 = 1000;
+    g.stop_fingers = 0x01;  // the index finger
+    REQUIRE(r.cycle(&g));
+    for (int i = 0; i < 300; ++i) r.cycle();
+    REQUIRE(r.motion->status().state == ArmMotionStatus::running);
+    r.contact.fingers = index_held ? 0x11 : 0x10;  // lf leaves the set: not a touch of the index
+    for (int i = 0; i < 3; ++i) r.cycle();
+    REQUIRE(r.motion->status().state == ArmMotionStatus::running);
+    r.contact.fingers = 0x11;  // the index in the held contact, no new onset
+    r.cycle();
+    if (index_held) {
+      CHECK(r.motion->status().state == ArmMotionStatus::running);
+      // Released, then a new onset with the index: that stops it as always.
+      r.contact.in_contact = 0;
+      r.contact.fingers = 0;
+      r.cycle();
+      CHECK(r.motion->status().state == ArmMotionStatus::running);
+      r.contact.in_contact = 1;
+      r.contact.fingers = 0x01;
+      r.contact.onsets = 2;
+      r.cycle();
+    }
+    CHECK(r.motion->status().state == ArmMotionStatus::stopping);
+    r.run_to_end();
+    CHECK(r.motion->status().state == ArmMotionStatus::stopped_on_contact);
+  }
+}
+
 TEST_CASE("bad goals are refused with a counted reason and nothing moves") {
   Rig r;
   idle(r);
