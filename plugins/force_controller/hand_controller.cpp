@@ -71,8 +71,14 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
     return;
   }
   // PST: pressure above the tare, which follows the sensor while the finger touches nothing.
-  // While pressed, the electronics' high-pass (time constant pst_highpass_s) bleeds a held
-  // pressure away: x = y + (1/tau) integral y dt undoes it.
+  // The electronics' high-pass (time constant pst_highpass_s) bleeds a held pressure away: its
+  // low-passed copy b of the cavity pressure, db/dt = y / tau with y the output, is tracked as
+  // highpass_kpa and added back (x = y + b). It is not forgotten when the finger lets go: b then
+  // decays with tau, and the output undershoots by it, clipped at 0 on the wire (u16); a reading
+  // of 0 tells nothing of b, which is then taken to decay as with nothing pressed. Forgetting it
+  // (as before) made the next press read low by what was left: a fixing hand pressed 3.2 N for
+  // a 2 N goal after a 35 s press. A clipped reading measures 0 N (the force lies somewhere
+  // under b; the force loop presses on until the sensor reads again), and leaves the tare as is.
   // A cycle without a sample of a sensor (its frame did not come in this cycle: pressure_valid
   // is per cycle) holds that finger's force as last measured, and the next sample covers the
   // time since its last one: no sample is not no force (a reading of 0 N mid-press made the force
@@ -88,14 +94,13 @@ void HandController::measure_rt(const ForceInputs& in) noexcept {
     const double p = in.hand->pressure_kpa[f];
     const bool pressed = (s_.mode == HandMode::force && (s_.fingers & (1u << f)) != 0) ||
                          (contact && (in.contact->fingers & (1u << f)) != 0);
+    const bool reads = p > 0;  // not clipped at the wire's 0
+    double& b = s_.highpass_kpa[sz(f)];
     const double above = p - s_.baseline_kpa[sz(f)];
-    if (contact && !pressed) {
-      s_.baseline_kpa[sz(f)] += a * (p - s_.baseline_kpa[sz(f)]);
-      s_.highpass_kpa[sz(f)] = 0;
-    } else if (c_.pst_highpass_s > 0) {
-      s_.highpass_kpa[sz(f)] += above * dt / c_.pst_highpass_s;
-    }
-    f_[sz(f)] = std::max(0.0, (above + s_.highpass_kpa[sz(f)]) / c_.kpa_per_n);
+    if (contact && !pressed && reads)
+      s_.baseline_kpa[sz(f)] += a * (p + b - s_.baseline_kpa[sz(f)]);
+    if (c_.pst_highpass_s > 0) b += (reads ? above : -b) * std::min(1.0, dt / c_.pst_highpass_s);
+    f_[sz(f)] = reads ? std::max(0.0, (above + b) / c_.kpa_per_n) : 0.0;
   }
 }
 

@@ -67,7 +67,8 @@ class HandController {
     std::array<float, kJoints> from{}, to{};    // posture ramp, retreat target
     std::array<double, kForceFingers> u{}, u_lo{}, u_hi{};
     std::array<double, kFingers> baseline_kpa{};
-    std::array<double, kFingers> highpass_kpa{};  // what the PST's high-pass took away while pressed
+    std::array<double, kFingers>
+        highpass_kpa{};  // the PST high-pass's low-passed pressure (what it takes away)
     std::array<double, kFingers> pst_gap_s{};     // since each PST sensor's last sample (s)
     double ramp_t = 0, ramp_T = 0;              // posture or force ramp: elapsed, duration (s)
     double f_from = 0, f_goal = 0, f_target = 0;
