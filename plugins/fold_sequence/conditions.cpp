@@ -295,7 +295,16 @@ Reason Machine::fault(const Sensing& in) noexcept {
       return found(n.arm_aborted, Reason::motion_aborted);
     }
   }
-  if (seen && pinch_lost(*sh))
+  // Off the way on every model state for pinch_lost_s: the tracker alone can put it there for a
+  // moment (a trial whose pinch held, 1.4 mm of slip in the world, aborted at the bend's top).
+  if (!seen) return Reason::none;  // a state without observations tells nothing either way
+  if (!pinch_lost(*sh)) {
+    m_.pinch_off_since_ns = 0;
+  } else if (m_.pinch_off_since_ns == 0) {
+    m_.pinch_off_since_ns = now;
+  }
+  if (m_.pinch_off_since_ns != 0 &&
+      static_cast<double>(now - m_.pinch_off_since_ns) * 1e-9 >= spec_.pinch_lost_s)
     return found("tracked grasp point off the pinch", Reason::pinch_lost);
   return Reason::none;
 }

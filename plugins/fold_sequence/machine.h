@@ -120,6 +120,7 @@ struct Memory {
   std::int64_t leaf_since_ns = 0;
   std::int64_t elapsed_ns[kStateCount] = {};  // time in each active state, pauses not counted
   std::int64_t vision_bad_since_ns = 0;       // 0: the sheet is seen
+  std::int64_t pinch_off_since_ns = 0;        // 0: the tracked grasp point is on the pinch's way
   std::uint32_t next_id = 1;
   std::uint32_t arm_id[2] = {0, 0};   // this state's arm goals (0: none)
   std::uint32_t hand_id[2] = {0, 0};  // this state's hand goals
