@@ -41,6 +41,7 @@ struct ForceConfig {
   // `joint_stiffness` by name over it (a wrist held stiff while the fingers press softly).
   std::array<double, kJoints> default_stiffness = filled(2.0);
   double force_limit_n = 5.0;     // hard limit per fingertip: exceeded -> retreat, fault event
+  int force_limit_samples = 3;    // ... on this many new samples of the finger in a row
   double max_goal_force_n = 4.0;  // goals above are refused (< force_limit_n)
   double settle_band = 0.05;      // |error| <= band x goal (and >= settle_band_n) ...
   double settle_band_n = 0.02;

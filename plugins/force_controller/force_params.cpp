@@ -94,6 +94,8 @@ ForceConfig read_force_config(const Params& p) {
   c.retreat_rad = p.get_in_range<double>("retreat_rad", c.retreat_rad, 0.0, 1.5);
   c.default_stiffness = read_stiffness(p);
   c.force_limit_n = p.get_in_range<double>("force_limit_n", c.force_limit_n, 0.01, 100.0);
+  c.force_limit_samples =
+      p.get_in_range<int>("force_limit_samples", c.force_limit_samples, 1, 1000);
   c.max_goal_force_n = p.get_in_range<double>("max_goal_force_n", 0.8 * c.force_limit_n, 0.0, 100.0);
   if (!(c.max_goal_force_n < c.force_limit_n)) p.fail("max_goal_force_n", "must be below force_limit_n");
   c.settle_band = p.get_in_range<double>("settle_band", c.settle_band, 1e-4, 1.0);

@@ -70,6 +70,9 @@ class HandController {
     std::array<double, kFingers>
         highpass_kpa{};  // the PST high-pass's low-passed pressure (what it takes away)
     std::array<double, kFingers> pst_gap_s{};     // since each PST sensor's last sample (s)
+    std::array<std::int32_t, kFingers>
+        over_limit{};                           // each finger's samples over the limit in a row
+    std::int64_t tactile_ns = 0;                // the taxel matrix sample last measured
     double ramp_t = 0, ramp_T = 0;              // posture or force ramp: elapsed, duration (s)
     double f_from = 0, f_goal = 0, f_target = 0;
     double in_band_s = 0;
@@ -113,7 +116,8 @@ class HandController {
 
  private:
   [[nodiscard]] HandInhibit check_inputs_rt(const ForceInputs& in) noexcept;
-  void measure_rt(const ForceInputs& in) noexcept;
+  // The fingertip forces f_ from this cycle's samples; returns the fingers with a new sample.
+  std::uint8_t measure_rt(const ForceInputs& in) noexcept;
   void enter_force_rt(std::uint8_t fingers, double force_n, double ramp_s) noexcept;
   void enter_retreat_rt() noexcept;
   void force_step_rt(double dt) noexcept;
