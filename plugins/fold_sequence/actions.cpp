@@ -115,6 +115,45 @@ bool Machine::back_out_of_grasp(Outbox& out) noexcept {
   return true;
 }
 
+int Machine::bend_passed() const noexcept {
+  if (m_.aborted_from != S::follow_via && m_.aborted_from != S::layer_lay) return 0;
+  if (!m_.arm_has_target[kPinching]) return 0;
+  return m_.aborted_from == S::layer_lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count);
+}
+
+bool Machine::back_out_of_bend(Outbox& out) noexcept {
+  // A pinch turned by the bend, lifted 30 mm and parked on a line (or in joint space, a line
+  // being out of reach there) swept the hand through the table (trials: 3443 N; 17.7 N, the
+  // park timed out). The way it came is within reach: via points k-1 .. 0 (the motion to via
+  // k was running; from the lay: all), above_mm, above_via in reverse.
+  const FoldSpec& f = spec_;
+  const int passed = bend_passed();
+  const int tail = 1 + f.grasp_above_via_count;  // above_mm and the above_via points
+  const int room = ArmGoal::kMaxPoints - tail;
+  if (passed == 0 || room < 1) return false;  // still by the grasp: lifted as before
+  const int step = passed <= room ? 1 : (passed + room - 1) / room;
+  double path[ArmGoal::kMaxPoints][3], turn[ArmGoal::kMaxPoints][4];
+  int n = 0;
+  const auto add = [&](const double* p, const double* q) {
+    for (int c = 0; c < 3; ++c) path[n][c] = p[c];
+    for (int c = 0; c < 4; ++c) turn[n][c] = q[c];
+    ++n;
+  };
+  for (int i = passed - 1; i >= 0 && n < room; i -= step) add(f.via_mm[i], f.via_orientation[i]);
+  if ((passed - 1) % step != 0) {  // via 0 skipped by the step: it ends the bend's way back
+    if (n == room) --n;
+    add(f.via_mm[0], f.via_orientation[0]);
+  }
+  add(f.grasp_above_mm, f.grasp_orientation);
+  for (int i = f.grasp_above_via_count - 1; i >= 0; --i)
+    add(f.grasp_above_via_mm[i], f.grasp_above_via_orientation[i]);
+  const int before = out.arm_count[kPinching];
+  arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n, path, turn, f.fold, 0, out);
+  if (out.arm_count[kPinching] > before)
+    out.arm[kPinching][before].kind = ArmGoal::retreat;  // taken while the hand retreats
+  return true;
+}
+
 void Machine::arm_park(int side, Outbox& out, bool joints) noexcept {
   const int s = side_of_role(spec_, side);  // park poses are per side
   const int before = out.arm_count[side];
@@ -418,10 +457,17 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       m_.sheet_step0 = in.sheet != nullptr ? in.sheet->step : 0;
       break;
     case S::finish_open:
-    case S::abort_open:
     case S::abort_reopen:
       hand_posture(kFixing, f.open_rad, in, out);
       hand_posture(kPinching, f.open_rad, in, out);
+      break;
+    case S::abort_open:
+      hand_posture(kFixing, f.open_rad, in, out);
+      // A pinch the bend carried lets go with its thumb only (prepinch): the lift backs it out the
+      // way it came (back_out_of_bend), which the index's pad frame reaches as long as the index
+      // keeps its curl (opened, the pad moved and arm_motion refused the way as unreachable, and
+      // the park in joint space swept the hand through the table). It opens in `reopen`, above.
+      hand_posture(kPinching, bend_passed() > 0 ? f.prepinch_rad : f.open_rad, in, out);
       break;
     case S::finish_lift:
       arm_lift(kFixing, f.release_lift_mm, out);
@@ -429,7 +475,8 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       break;
     case S::abort_lift:
       arm_lift(kFixing, f.release_lift_mm, out);
-      if (!back_out_of_grasp(out)) arm_lift(kPinching, f.release_lift_mm, out);
+      if (!back_out_of_grasp(out) && !back_out_of_bend(out))
+        arm_lift(kPinching, f.release_lift_mm, out);
       break;
     case S::finish_park:
     case S::abort_park:

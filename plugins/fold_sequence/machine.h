@@ -211,6 +211,14 @@ class Machine {
   // back along the reach path's points it had passed (a reach aborted on its way: those before
   // the segment it ran) to above_mm (false: not from there, nothing sent). RT.
   bool back_out_of_grasp(Outbox& out) noexcept;
+  // ... and when it came from the bend or the lay: back through the via points it had passed
+  // (the last one first; every other one when they do not fit one goal, the first always), to
+  // above_mm and back through above_via: the way it came, which the park line ends (false: not
+  // from there, or still by the grasp: nothing sent). RT.
+  bool back_out_of_bend(Outbox& out) noexcept;
+  // The via points the pinch had passed when the fold aborted in the bend or the lay (0: not from
+  // there).
+  [[nodiscard]] int bend_passed() const noexcept;
   // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
   // pinch as the bend laid it (lay, withdraw).
   void pinch_as_laid(const double p[3], Outbox& out) noexcept;

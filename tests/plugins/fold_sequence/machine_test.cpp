@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 using namespace crease;
 using namespace crease::fold;
@@ -222,5 +223,75 @@ TEST_CASE("an abort from the grasp's reach backs the pinching hand out the way i
         CHECK(pin.position_mm[k][i] == doctest::Approx(f.grasp_path_mm[c.back - 1 - k][i]));
     for (int i = 0; i < 3; ++i)
       CHECK(pin.position_mm[c.back][i] == doctest::Approx(f.grasp_above_mm[i]));
+  }
+}
+
+TEST_CASE(
+    "an abort from the bend or the lay backs the pinching hand out through the via points it "
+    "passed, then the way it came") {
+  // Lifted 30 mm and parked from a pinch the bend had turned, the hand swept through the table
+  // (trials: 3443 N; 17.7 N and the park timed out). Still by the grasp (the motion to the
+  // first via point), it lifts straight up as before.
+  const FoldSpec f = half();
+  REQUIRE(f.via_count == 8);
+  REQUIRE(f.grasp_above_via_count == 1);
+  struct Case {
+    S from;
+    int via;                // the via point the pinch was moving to
+    std::vector<int> back;  // the via points backed through, in order (empty: lifted)
+  };
+  for (const Case& c : {Case{S::follow_via, 3, {2, 1, 0}}, Case{S::follow_via, 1, {0}},
+                        Case{S::layer_lay, 7, {7, 5, 3, 1, 0}}, Case{S::follow_via, 0, {}},
+                        Case{S::bend_crease, 0, {}}}) {
+    CAPTURE(static_cast<int>(c.from));
+    CAPTURE(c.via);
+    Machine m(f);
+    Memory saved = m.memory();
+    saved.leaf = c.from;
+    saved.via = static_cast<std::uint8_t>(c.via);
+    saved.arm_has_target[kFixing] = saved.arm_has_target[kPinching] = 1;
+    saved.arm_tool[kPinching] = f.grasp_tool;
+    REQUIRE(m.restore(saved));
+    Quiet q;
+    Outbox out;
+    std::int64_t now = 1'000'000;
+    m.fail(Reason::pinch_lost);
+    m.step(q.at(now), out);
+    REQUIRE(m.memory().leaf == S::abort_stop);
+    HandGoal opening{};  // the pinching hand's goal as the retreat opens the hands
+    for (int k = 0; k < 10 && m.memory().leaf != S::abort_lift; ++k) {
+      now += 30'000'000'000;  // past every timeout: stop, open
+      m.step(q.at(now), out);
+      if (m.memory().leaf == S::abort_open && out.hand_count[kPinching] > 0)
+        opening = out.hand[kPinching][0];
+    }
+    REQUIRE(m.memory().leaf == S::abort_lift);
+    // Backed out of the bend, the pinch lets go with its thumb only (prepinch: the index, whose
+    // pad frame the way back is planned for, keeps its curl); otherwise the hand opens.
+    REQUIRE(opening.mode == HandMode::posture);
+    const float* expected = c.back.empty() ? f.open_rad : f.prepinch_rad;
+    for (int j = 0; j < kHandJoints; ++j)
+      CHECK(opening.target_rad[j] == doctest::Approx(expected[j]));
+    REQUIRE(out.arm_count[kPinching] == 1);
+    const ArmGoal& pin = out.arm[kPinching][0];
+    if (c.back.empty()) {
+      CHECK(pin.frame == ArmGoal::measured);  // straight up
+      CHECK(pin.point_count == 1);
+      continue;
+    }
+    REQUIRE(pin.frame == ArmGoal::sheet);
+    CHECK(pin.kind == ArmGoal::retreat);
+    const int n = static_cast<int>(c.back.size());
+    REQUIRE(pin.point_count == n + 2);  // the via points, above_mm, above_via[0]
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < 3; ++i)
+        CHECK(pin.position_mm[k][i] ==
+              doctest::Approx(f.via_mm[c.back[static_cast<std::size_t>(k)]][i]));
+    CHECK(pin.orientation[0][0] == doctest::Approx(f.via_orientation[c.back[0]][0]));
+    for (int i = 0; i < 3; ++i) {
+      CHECK(pin.position_mm[n][i] == doctest::Approx(f.grasp_above_mm[i]));
+      CHECK(pin.position_mm[n + 1][i] == doctest::Approx(f.grasp_above_via_mm[0][i]));
+    }
+    CHECK(pin.orientation[n + 1][1] == doctest::Approx(f.grasp_above_via_orientation[0][1]));
   }
 }
