@@ -19,6 +19,7 @@
 #include "core/port_types/sheet_state.h"
 #include "core/port_types/world_state.h"
 #include "plugins/fold_sequence/fold_spec.h"
+#include "plugins/fold_sequence/sheet_geometry.h"
 #include "plugins/fold_sequence/states.h"
 #include "plugins/robot_model/robot_params.h"
 #include "plugins/sim_world/bus_fault_plan.h"
@@ -69,6 +70,17 @@ std::string fold_instance(const config::DaemonConfig& cfg) {
 }
 
 // The port INSTANCE's port KEY is bound to (KEY itself when not remapped).
+// Where the tracked sheet's frame and the truth's put the near half's centre apart (mm).
+double frame_error_mm(const SheetState& tracked, const SheetState& truth) {
+  fold::SheetFrame a, b;
+  if (!fold::sheet_frame(tracked, a) || !fold::sheet_frame(truth, b)) return std::nan("");
+  const double p[3] = {105.0, 74.25, 0.0};
+  double pa[3], pb[3];
+  fold::sheet_to_world(a, p, pa);
+  fold::sheet_to_world(b, p, pb);
+  return std::hypot(pa[0] - pb[0], pa[1] - pb[1], pa[2] - pb[2]);
+}
+
 std::string port_of(const config::DaemonConfig& cfg, const std::string& instance, const std::string& key) {
   for (const auto& p : cfg.plugins)
     if (p.name == instance) {
@@ -160,6 +172,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     target.flap_corner_mm[1] = spec.corner_mm[1];
     r.draws = describe_draws(cfg);
     const std::string status_name = port_of(cfg, fold, "sequence_status");
+    const std::string tracked_name =
+        port_of(cfg, fold, "sheet_state");  // the model's sheet, as the sequence reads it
     // The hands' force controllers' status, as the sequence reads it.
     const std::string hand_status_name[2] = {port_of(cfg, fold, "hand_r_status"), port_of(cfg, fold, "hand_l_status")};
     const std::string contact_name[2] = {port_of(cfg, fold, "contact_r_state"),
@@ -180,6 +194,7 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     std::unique_ptr<rt::LatestReader<ContactState>> contact_state[2] = {
         reader<ContactState>(host, contact_name[0]), reader<ContactState>(host, contact_name[1])};
     auto truth = reader<SheetState>(host, "sheet_truth");
+    auto tracked = reader<SheetState>(host, tracked_name);
     auto reference = std::make_unique<SheetState>();
     bool have_reference = false;
     std::atomic<bool> daemon_ended{false};  // run() returned (or threw) before the supervisor ended it
@@ -232,6 +247,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
                          {window_measured[0], window_measured[1]},
                          {window_tip[0], window_tip[1]},
                          {window_tip_z[0], window_tip_z[1]}};
+          if (tracked != nullptr && tracked->poll().has_data() && truth->poll().has_data())
+            x.frame_err_mm = frame_error_mm(tracked->value(), truth->value());
           for (int h = 0; h < 2; ++h)
             if (contact_state[h]->poll().has_data()) {
               const ContactState& c = contact_state[h]->value();
@@ -380,7 +397,8 @@ nlohmann::json to_json(const TrialResult& r) {
       {"tip_r", nlohmann::json::array()},        {"tip_l", nlohmann::json::array()},
       {"tip_r_z_mm", nlohmann::json::array()},   {"tip_l_z_mm", nlohmann::json::array()},
       {"contact_r", nlohmann::json::array()},    {"contact_l", nlohmann::json::array()},
-      {"onsets_r", nlohmann::json::array()},     {"onsets_l", nlohmann::json::array()}};
+      {"onsets_r", nlohmann::json::array()},     {"onsets_l", nlohmann::json::array()},
+      {"frame_mm", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -398,6 +416,7 @@ nlohmann::json to_json(const TrialResult& r) {
     series["tip_l_z_mm"].push_back(num(x.force_tip_z_mm[1]));
     series["contact_r"].push_back(x.contact_fingers[0]);
     series["contact_l"].push_back(x.contact_fingers[1]);
+    series["frame_mm"].push_back(num(x.frame_err_mm));
     series["onsets_r"].push_back(x.contact_onsets[0]);
     series["onsets_l"].push_back(x.contact_onsets[1]);
   }
@@ -491,6 +510,7 @@ TrialResult from_json(const nlohmann::json& j) {
         v.force_tip_z_mm[0] = num(x.at("tip_r_z_mm")[k]);
         v.force_tip_z_mm[1] = num(x.at("tip_l_z_mm")[k]);
       }
+      if (x.contains("frame_mm")) v.frame_err_mm = num(x.at("frame_mm")[k]);
       if (x.contains("contact_r")) {
         v.contact_fingers[0] = x.at("contact_r")[k].get<int>();
         v.contact_fingers[1] = x.at("contact_l")[k].get<int>();

@@ -63,6 +63,11 @@ struct SeriesSample {
   // on a new one).
   int contact_fingers[2] = {-1, -1};
   long contact_onsets[2] = {-1, -1};
+  // How far the tracked sheet's frame (sheet_state's, in which the sequence's goals lie) puts
+  // the near half's centre (u 105, v 74 mm, on the sheet) from where the truth's frame puts it,
+  // mm; NaN without both. A contact descent 5 mm under the frame's plane misses a sheet lying
+  // lower than that.
+  double frame_err_mm = std::numeric_limits<double>::quiet_NaN();
 };
 inline constexpr double kSeriesS = 0.02;
 

@@ -269,7 +269,8 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
                       {4, -1},
                       {12.5, std::nan("")},
                       {0x11, -1},
-                      {3, -1}});
+                      {3, -1},
+                      17.5});
   b.score.stretch_at_mm[0] = 52.5;
   b.score.stretch_at_mm[1] = 7.425;
   b.sheet_nodes_u = 2;
@@ -300,4 +301,6 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(back.series[0].contact_onsets[0] == 3);
   CHECK(back.series[0].contact_fingers[1] == -1);
   CHECK(back.series[0].contact_onsets[1] == -1);
+  // ... and how far the tracked sheet's frame was from the truth's.
+  CHECK(back.series[0].frame_err_mm == 17.5);
 }
