@@ -296,7 +296,7 @@ Reason Machine::fault(const Sensing& in) noexcept {
     }
   }
   // Off the way on every model state for pinch_lost_s: the tracker alone can put it there for a
-  // moment (a trial whose pinch held, 1.4 mm of slip in the world, aborted at the bend's top).
+  // moment (its error over a trial's frames reaches 30-60 mm at its worst).
   if (!seen) return Reason::none;  // a state without observations tells nothing either way
   if (!pinch_lost(*sh)) {
     m_.pinch_off_since_ns = 0;

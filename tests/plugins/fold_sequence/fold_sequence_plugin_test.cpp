@@ -336,31 +336,31 @@ TEST_CASE("the pinch is felt: a closing whose pads squeeze nothing holds grasp/p
 
 TEST_CASE(
     "the pinch lost in the bend: the tracked grasp point left behind aborts with pinch_lost") {
-  // The fifth via point's motion runs long (never reached). Failing variant first: the tracked
-  // grasp point went where the pinch took it (the fourth via point, on the way): the bend goes on.
-  const auto stall_via4 = [](int side, const ArmGoal& g, int) {
-    return side == kPin && g.frame == ArmGoal::sheet && near(g.position_mm[0][1], 90.2) &&
-           g.position_mm[0][2] < -90;
+  // The fourth via point's motion runs long (never reached). Failing variant first: the tracked
+  // grasp point went where the pinch took it (the third via point, on the way): the bend goes on.
+  const auto stall_via3 = [](int side, const ArmGoal& g, int) {
+    return side == kPin && g.frame == ArmGoal::sheet && near(g.position_mm[0][1], 148.5) &&
+           g.position_mm[0][2] < -100;
   };
   Rig r;
-  r.stalls = stall_via4;
-  start_and_run_to(r, "fold/bend/follow_via[4]");
+  r.stalls = stall_via3;
+  start_and_run_to(r, "fold/bend/follow_via[3]");
   r.run(3000);
-  CHECK(std::string(r.status().path) == "fold/bend/follow_via[4]");
+  CHECK(std::string(r.status().path) == "fold/bend/follow_via[3]");
   CHECK(r.status().phase != SequenceStatus::aborted);
-  // Lost: the point stays on the table by the far edge, 125 mm from the way since the third via
-  // point (80 allowed). Judged from 150 ms into the state, and only when off the way for
-  // pinch_lost_s (0.3 s) on end: still bending 0.4 s in (failing variant: the first model state
-  // off the way aborts, 150 ms in).
+  // Lost: the point stays on the table by the far edge, 73 mm from the way up since the second
+  // via point (50 allowed; the way before it passes 25 mm from the edge). Judged from 150 ms into
+  // the state, and only when off the way for pinch_lost_s (0.3 s) on end: still bending 0.4 s in
+  // (failing variant: the first model state off the way aborts, 150 ms in).
   Rig s;
-  s.stalls = stall_via4;
+  s.stalls = stall_via3;
   s.pinch_carries = false;
   s.command(Command::start);
-  REQUIRE(s.run_to("fold/bend/follow_via[4]"));
+  REQUIRE(s.run_to("fold/bend/follow_via[3]"));
   s.run(400);
-  CHECK(std::string(s.status().path) == "fold/bend/follow_via[4]");
+  CHECK(std::string(s.status().path) == "fold/bend/follow_via[3]");
   expect_abort(s, crease::fold::Reason::pinch_lost);
-  CHECK(s.paths()[s.paths().size() - 1 - kRetreat.size()] == "fold/bend/follow_via[4]");
+  CHECK(s.paths()[s.paths().size() - 1 - kRetreat.size()] == "fold/bend/follow_via[3]");
 }
 
 TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {

@@ -71,7 +71,7 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.prepinch_rad[3] == doctest::Approx(1.428));
   CHECK(h.pinch_rad[15] == doctest::Approx(0.77));  // THJ5 closed
   CHECK(h.has_release_stiffness);
-  CHECK(h.pinch_lost_mm == 80.0);
+  CHECK(h.pinch_lost_mm == 50.0);
   CHECK(h.pinch_lost_s == 0.3);
   CHECK(h.release_stiffness[15] == doctest::Approx(0.5));  // the thumb soft while it opens
   CHECK(h.release_stiffness[3] == doctest::Approx(2.0));
