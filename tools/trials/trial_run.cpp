@@ -247,8 +247,15 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
                          {window_measured[0], window_measured[1]},
                          {window_tip[0], window_tip[1]},
                          {window_tip_z[0], window_tip_z[1]}};
-          if (tracked != nullptr && tracked->poll().has_data() && truth->poll().has_data())
+          if (tracked->poll().has_data() && truth->poll().has_data())
             x.frame_err_mm = frame_error_mm(tracked->value(), truth->value());
+          double g[3];
+          if (truth->poll().has_data() &&
+              fold::node_at(truth->value(), spec.grasp_at_mm[0], spec.grasp_at_mm[1], g))
+            x.grasp_z_mm = g[2];
+          if (tracked->poll().has_data() &&
+              fold::node_at(tracked->value(), spec.grasp_at_mm[0], spec.grasp_at_mm[1], g))
+            x.grasp_tracked_z_mm = g[2];
           for (int h = 0; h < 2; ++h)
             if (contact_state[h]->poll().has_data()) {
               const ContactState& c = contact_state[h]->value();
@@ -390,15 +397,23 @@ double num(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : s
 nlohmann::json to_json(const TrialResult& r) {
   nlohmann::json timeline = nlohmann::json::array();
   for (const auto& e : r.timeline) timeline.push_back({{"t_s", e.t_s}, {"path", e.path}, {"why", e.why}});
-  nlohmann::json series = {
-      {"t_s", nlohmann::json::array()},          {"force_r_n", nlohmann::json::array()},
-      {"force_l_n", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
-      {"measured_r_n", nlohmann::json::array()}, {"measured_l_n", nlohmann::json::array()},
-      {"tip_r", nlohmann::json::array()},        {"tip_l", nlohmann::json::array()},
-      {"tip_r_z_mm", nlohmann::json::array()},   {"tip_l_z_mm", nlohmann::json::array()},
-      {"contact_r", nlohmann::json::array()},    {"contact_l", nlohmann::json::array()},
-      {"onsets_r", nlohmann::json::array()},     {"onsets_l", nlohmann::json::array()},
-      {"frame_mm", nlohmann::json::array()}};
+  nlohmann::json series = {{"t_s", nlohmann::json::array()},
+                           {"force_r_n", nlohmann::json::array()},
+                           {"force_l_n", nlohmann::json::array()},
+                           {"stretch", nlohmann::json::array()},
+                           {"measured_r_n", nlohmann::json::array()},
+                           {"measured_l_n", nlohmann::json::array()},
+                           {"tip_r", nlohmann::json::array()},
+                           {"tip_l", nlohmann::json::array()},
+                           {"tip_r_z_mm", nlohmann::json::array()},
+                           {"tip_l_z_mm", nlohmann::json::array()},
+                           {"contact_r", nlohmann::json::array()},
+                           {"contact_l", nlohmann::json::array()},
+                           {"onsets_r", nlohmann::json::array()},
+                           {"onsets_l", nlohmann::json::array()},
+                           {"frame_mm", nlohmann::json::array()},
+                           {"grasp_z_mm", nlohmann::json::array()},
+                           {"grasp_tracked_z_mm", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -417,6 +432,8 @@ nlohmann::json to_json(const TrialResult& r) {
     series["contact_r"].push_back(x.contact_fingers[0]);
     series["contact_l"].push_back(x.contact_fingers[1]);
     series["frame_mm"].push_back(num(x.frame_err_mm));
+    series["grasp_z_mm"].push_back(num(x.grasp_z_mm));
+    series["grasp_tracked_z_mm"].push_back(num(x.grasp_tracked_z_mm));
     series["onsets_r"].push_back(x.contact_onsets[0]);
     series["onsets_l"].push_back(x.contact_onsets[1]);
   }
@@ -511,6 +528,10 @@ TrialResult from_json(const nlohmann::json& j) {
         v.force_tip_z_mm[1] = num(x.at("tip_l_z_mm")[k]);
       }
       if (x.contains("frame_mm")) v.frame_err_mm = num(x.at("frame_mm")[k]);
+      if (x.contains("grasp_z_mm")) {
+        v.grasp_z_mm = num(x.at("grasp_z_mm")[k]);
+        v.grasp_tracked_z_mm = num(x.at("grasp_tracked_z_mm")[k]);
+      }
       if (x.contains("contact_r")) {
         v.contact_fingers[0] = x.at("contact_r")[k].get<int>();
         v.contact_fingers[1] = x.at("contact_l")[k].get<int>();

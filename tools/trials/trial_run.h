@@ -68,6 +68,11 @@ struct SeriesSample {
   // mm; NaN without both. A contact descent 5 mm under the frame's plane misses a sheet lying
   // lower than that.
   double frame_err_mm = std::numeric_limits<double>::quiet_NaN();
+  // The height over the table of the world's node at the fold's grasp point (grasp at_mm's u, v),
+  // and the tracked sheet's, mm: a pinch that holds carries the first up through the bend;
+  // lost, it lies on the table (pinch_lost judges the second).
+  double grasp_z_mm = std::numeric_limits<double>::quiet_NaN();
+  double grasp_tracked_z_mm = std::numeric_limits<double>::quiet_NaN();
 };
 inline constexpr double kSeriesS = 0.02;
 
