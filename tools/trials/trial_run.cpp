@@ -70,14 +70,14 @@ std::string fold_instance(const config::DaemonConfig& cfg) {
 }
 
 // The port INSTANCE's port KEY is bound to (KEY itself when not remapped).
-// Where the tracked sheet's frame and the truth's put the near half's centre apart (mm).
-double frame_error_mm(const SheetState& tracked, const SheetState& truth) {
-  fold::SheetFrame a, b;
-  if (!fold::sheet_frame(tracked, a) || !fold::sheet_frame(truth, b)) return std::nan("");
+// Where two sheets' frames put the near half's centre apart (mm).
+double frame_error_mm(const SheetState& a, const SheetState& b) {
+  fold::SheetFrame fa, fb;
+  if (!fold::sheet_frame(a, fa) || !fold::sheet_frame(b, fb)) return std::nan("");
   const double p[3] = {105.0, 74.25, 0.0};
   double pa[3], pb[3];
-  fold::sheet_to_world(a, p, pa);
-  fold::sheet_to_world(b, p, pb);
+  fold::sheet_to_world(fa, p, pa);
+  fold::sheet_to_world(fb, p, pb);
   return std::hypot(pa[0] - pb[0], pa[1] - pb[1], pa[2] - pb[2]);
 }
 
@@ -196,6 +196,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
     auto truth = reader<SheetState>(host, "sheet_truth");
     auto tracked = reader<SheetState>(host, tracked_name);
     auto reference = std::make_unique<SheetState>();
+    auto start_truth = std::make_unique<SheetState>();  // the truth at the sequence's start
+    bool have_start_truth = false;
     bool have_reference = false;
     std::atomic<bool> daemon_ended{false};  // run() returned (or threw) before the supervisor ended it
 
@@ -249,6 +251,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
                          {window_tip_z[0], window_tip_z[1]}};
           if (tracked->poll().has_data() && truth->poll().has_data())
             x.frame_err_mm = frame_error_mm(tracked->value(), truth->value());
+          if (have_start_truth && truth->poll().has_data())
+            x.frame_moved_mm = frame_error_mm(*start_truth, truth->value());
           double g[3];
           if (truth->poll().has_data() &&
               fold::node_at(truth->value(), spec.grasp_at_mm[0], spec.grasp_at_mm[1], g))
@@ -273,6 +277,8 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
           if (truth->poll().has_data()) {
             *reference = truth->value();  // the slip's reference until the grasp
             have_reference = true;
+            *start_truth = truth->value();
+            have_start_truth = true;
           }
         }
         if (s.transitions != seen_transitions) {
@@ -413,7 +419,8 @@ nlohmann::json to_json(const TrialResult& r) {
                            {"onsets_l", nlohmann::json::array()},
                            {"frame_mm", nlohmann::json::array()},
                            {"grasp_z_mm", nlohmann::json::array()},
-                           {"grasp_tracked_z_mm", nlohmann::json::array()}};
+                           {"grasp_tracked_z_mm", nlohmann::json::array()},
+                           {"frame_moved_mm", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -432,6 +439,7 @@ nlohmann::json to_json(const TrialResult& r) {
     series["contact_r"].push_back(x.contact_fingers[0]);
     series["contact_l"].push_back(x.contact_fingers[1]);
     series["frame_mm"].push_back(num(x.frame_err_mm));
+    series["frame_moved_mm"].push_back(num(x.frame_moved_mm));
     series["grasp_z_mm"].push_back(num(x.grasp_z_mm));
     series["grasp_tracked_z_mm"].push_back(num(x.grasp_tracked_z_mm));
     series["onsets_r"].push_back(x.contact_onsets[0]);
@@ -528,6 +536,7 @@ TrialResult from_json(const nlohmann::json& j) {
         v.force_tip_z_mm[1] = num(x.at("tip_l_z_mm")[k]);
       }
       if (x.contains("frame_mm")) v.frame_err_mm = num(x.at("frame_mm")[k]);
+      if (x.contains("frame_moved_mm")) v.frame_moved_mm = num(x.at("frame_moved_mm")[k]);
       if (x.contains("grasp_z_mm")) {
         v.grasp_z_mm = num(x.at("grasp_z_mm")[k]);
         v.grasp_tracked_z_mm = num(x.at("grasp_tracked_z_mm")[k]);

@@ -68,6 +68,9 @@ struct SeriesSample {
   // mm; NaN without both. A contact descent 5 mm under the frame's plane misses a sheet lying
   // lower than that.
   double frame_err_mm = std::numeric_limits<double>::quiet_NaN();
+  // ... and how far the truth's frame moved that point since the sequence's start (the world's
+  // near half dragged, not the tracker wrong), mm.
+  double frame_moved_mm = std::numeric_limits<double>::quiet_NaN();
   // The height over the table of the world's node at the fold's grasp point (grasp at_mm's u, v),
   // and the tracked sheet's, mm: a pinch that holds carries the first up through the bend;
   // lost, it lies on the table (pinch_lost judges the second).

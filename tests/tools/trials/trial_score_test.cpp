@@ -271,6 +271,7 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
                       {0x11, -1},
                       {3, -1},
                       17.5,
+                      6.5,
                       96.0,
                       41.5});
   b.score.stretch_at_mm[0] = 52.5;
@@ -305,6 +306,7 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(back.series[0].contact_onsets[1] == -1);
   // ... and how far the tracked sheet's frame was from the truth's.
   CHECK(back.series[0].frame_err_mm == 17.5);
+  CHECK(back.series[0].frame_moved_mm == 6.5);
   // ... and the grasp point's height in the world and in the tracked sheet.
   CHECK(back.series[0].grasp_z_mm == 96.0);
   CHECK(back.series[0].grasp_tracked_z_mm == 41.5);
