@@ -253,6 +253,9 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
             x.frame_err_mm = frame_error_mm(tracked->value(), truth->value());
           if (have_start_truth && truth->poll().has_data())
             x.frame_moved_mm = frame_error_mm(*start_truth, truth->value());
+          if (world_state->poll().has_data())
+            for (int h = 0; h < 2; ++h)
+              x.ff_z_mm[h] = world_state->value().hand[h].tip[0].position_mm[2];
           double g[3];
           if (truth->poll().has_data() &&
               fold::node_at(truth->value(), spec.grasp_at_mm[0], spec.grasp_at_mm[1], g))
@@ -420,7 +423,9 @@ nlohmann::json to_json(const TrialResult& r) {
                            {"frame_mm", nlohmann::json::array()},
                            {"grasp_z_mm", nlohmann::json::array()},
                            {"grasp_tracked_z_mm", nlohmann::json::array()},
-                           {"frame_moved_mm", nlohmann::json::array()}};
+                           {"frame_moved_mm", nlohmann::json::array()},
+                           {"ff_r_z_mm", nlohmann::json::array()},
+                           {"ff_l_z_mm", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -440,6 +445,8 @@ nlohmann::json to_json(const TrialResult& r) {
     series["contact_l"].push_back(x.contact_fingers[1]);
     series["frame_mm"].push_back(num(x.frame_err_mm));
     series["frame_moved_mm"].push_back(num(x.frame_moved_mm));
+    series["ff_r_z_mm"].push_back(num(x.ff_z_mm[0]));
+    series["ff_l_z_mm"].push_back(num(x.ff_z_mm[1]));
     series["grasp_z_mm"].push_back(num(x.grasp_z_mm));
     series["grasp_tracked_z_mm"].push_back(num(x.grasp_tracked_z_mm));
     series["onsets_r"].push_back(x.contact_onsets[0]);
@@ -537,6 +544,10 @@ TrialResult from_json(const nlohmann::json& j) {
       }
       if (x.contains("frame_mm")) v.frame_err_mm = num(x.at("frame_mm")[k]);
       if (x.contains("frame_moved_mm")) v.frame_moved_mm = num(x.at("frame_moved_mm")[k]);
+      if (x.contains("ff_r_z_mm")) {
+        v.ff_z_mm[0] = num(x.at("ff_r_z_mm")[k]);
+        v.ff_z_mm[1] = num(x.at("ff_l_z_mm")[k]);
+      }
       if (x.contains("grasp_z_mm")) {
         v.grasp_z_mm = num(x.at("grasp_z_mm")[k]);
         v.grasp_tracked_z_mm = num(x.at("grasp_tracked_z_mm")[k]);

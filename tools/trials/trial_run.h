@@ -76,6 +76,10 @@ struct SeriesSample {
   // lost, it lies on the table (pinch_lost judges the second).
   double grasp_z_mm = std::numeric_limits<double>::quiet_NaN();
   double grasp_tracked_z_mm = std::numeric_limits<double>::quiet_NaN();
+  // Each hand's index pad (its tool frame in the fold) over the table at the sample, mm, in
+  // contact or not: where a descent that touched nothing ended.
+  double ff_z_mm[2] = {std::numeric_limits<double>::quiet_NaN(),
+                       std::numeric_limits<double>::quiet_NaN()};
 };
 inline constexpr double kSeriesS = 0.02;
 

@@ -273,7 +273,8 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
                       17.5,
                       6.5,
                       96.0,
-                      41.5});
+                      41.5,
+                      {33.0, std::nan("")}});
   b.score.stretch_at_mm[0] = 52.5;
   b.score.stretch_at_mm[1] = 7.425;
   b.sheet_nodes_u = 2;
@@ -310,4 +311,6 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   // ... and the grasp point's height in the world and in the tracked sheet.
   CHECK(back.series[0].grasp_z_mm == 96.0);
   CHECK(back.series[0].grasp_tracked_z_mm == 41.5);
+  CHECK(back.series[0].ff_z_mm[0] == 33.0);  // the right index pad's height; the left's unknown
+  CHECK(std::isnan(back.series[0].ff_z_mm[1]));
 }
