@@ -121,7 +121,21 @@ int Machine::bend_passed() const noexcept {
   return m_.aborted_from == S::layer_lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count);
 }
 
-bool Machine::back_out_of_bend(Outbox& out) noexcept {
+bool Machine::above_via_in_sheet(int k, const Sensing& in, double p[3],
+                                 double q[4]) const noexcept {
+  const FoldSpec& f = spec_;
+  if (!f.grasp_above_via_world[k]) {
+    for (int c = 0; c < 3; ++c) p[c] = f.grasp_above_via_mm[k][c];
+    for (int c = 0; c < 4; ++c) q[c] = f.grasp_above_via_orientation[k][c];
+    return true;
+  }
+  SheetFrame frame;
+  if (in.sheet == nullptr || !sheet_frame(*in.sheet, frame)) return false;
+  world_to_sheet(frame, f.grasp_above_via_mm[k], f.grasp_above_via_orientation[k], p, q);
+  return true;
+}
+
+bool Machine::back_out_of_bend(const Sensing& in, Outbox& out) noexcept {
   // A pinch turned by the bend, lifted 30 mm and parked on a line (or in joint space, a line
   // being out of reach there) swept the hand through the table (trials: 3443 N; 17.7 N, the
   // park timed out). The way it came is within reach: via points k-1 .. 0 (the motion to via
@@ -145,8 +159,10 @@ bool Machine::back_out_of_bend(Outbox& out) noexcept {
     add(f.via_mm[0], f.via_orientation[0]);
   }
   add(f.grasp_above_mm, f.grasp_orientation);
-  for (int i = f.grasp_above_via_count - 1; i >= 0; --i)
-    add(f.grasp_above_via_mm[i], f.grasp_above_via_orientation[i]);
+  for (int i = f.grasp_above_via_count - 1; i >= 0; --i) {
+    double p[3], q[4];
+    if (above_via_in_sheet(i, in, p, q)) add(p, q);
+  }
   const int before = out.arm_count[kPinching];
   arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n, path, turn, f.fold, 0, out);
   if (out.arm_count[kPinching] > before)
@@ -349,11 +365,9 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::grasp_shape: hand_posture(kPinching, f.prepinch_rad, in, out); break;
     case S::grasp_above: {
       double path[kMaxGraspPath + 1][3], turn[kMaxGraspPath + 1][4];
-      const int n = f.grasp_above_via_count;
-      for (int k = 0; k < n; ++k) {
-        for (int c = 0; c < 3; ++c) path[k][c] = f.grasp_above_via_mm[k][c];
-        for (int c = 0; c < 4; ++c) turn[k][c] = f.grasp_above_via_orientation[k][c];
-      }
+      int n = 0;  // a world point without a tracked sheet to put it in is left out
+      for (int k = 0; k < f.grasp_above_via_count; ++k)
+        if (above_via_in_sheet(k, in, path[n], turn[n])) ++n;
       for (int c = 0; c < 3; ++c) path[n][c] = f.grasp_above_mm[c];
       for (int c = 0; c < 4; ++c) turn[n][c] = f.grasp_orientation[c];
       arm_path(kPinching, f.grasp_tool, ArmGoal::sheet, n + 1, path, turn, f.approach, 0, out);
@@ -475,7 +489,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       break;
     case S::abort_lift:
       arm_lift(kFixing, f.release_lift_mm, out);
-      if (!back_out_of_grasp(out) && !back_out_of_bend(out))
+      if (!back_out_of_grasp(out) && !back_out_of_bend(in, out))
         arm_lift(kPinching, f.release_lift_mm, out);
       break;
     case S::finish_park:

@@ -219,6 +219,18 @@ void read(const Params& p, FoldSpec& f) {
   f.pinch_force_n = b.get_in_range<double>("pinch_force_n", 0.2, 0.01, 10.0);
   f.grasp_above_via_count =
       grasp_points(b, "above_via", "above_mm", f.grasp_above_via_mm, f.grasp_above_via_orientation);
+  {
+    const std::vector<Params> vias = b.list("above_via");
+    for (int i = 0; i < f.grasp_above_via_count; ++i) {
+      const Params& v = vias[static_cast<std::size_t>(i)];
+      const std::string frame = v.get<std::string>("frame", "sheet");
+      if (frame != "sheet" && frame != "world")
+        v.fail("frame", "expected sheet or world, got '" + frame + "'");
+      f.grasp_above_via_world[i] = frame == "world";
+      if (f.grasp_above_via_world[i])
+        f.grasp_above_via_mm[i][2] = -f.grasp_above_via_mm[i][2];  // z up as given
+    }
+  }
   sheet_point(b, "above_mm", f.grasp_above_mm);
   f.grasp_path_count = grasp_points(b, "path", "at_mm", f.grasp_path_mm, nullptr);
   sheet_point(b, "at_mm", f.grasp_at_mm);

@@ -99,6 +99,10 @@ struct FoldSpec {
   int grasp_above_via_count = 0;   // points the pinching tool passes on its way to above_mm,
   double grasp_above_via_mm[kMaxGraspPath][3] = {};         // each with its own orientation
   double grasp_above_via_orientation[kMaxGraspPath][4] = {};  // (a turn the straight path cannot make)
+  // Per above_via point, `frame: world`: its at_mm (x, y, z up) and orientation are the world's,
+  // the same whatever the sheet's yaw (the sequence puts it into the sheet frame it sends in);
+  // else (`sheet`, the default) a sheet point like the others, turning with the sheet.
+  bool grasp_above_via_world[kMaxGraspPath] = {};
   double grasp_above_mm[3] = {};   // sheet frame
   int grasp_path_count = 0;
   double grasp_path_mm[kMaxGraspPath][3] = {};

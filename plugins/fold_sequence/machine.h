@@ -215,7 +215,11 @@ class Machine {
   // (the last one first; every other one when they do not fit one goal, the first always), to
   // above_mm and back through above_via: the way it came, which the park line ends (false: not
   // from there, or still by the grasp: nothing sent). RT.
-  bool back_out_of_bend(Outbox& out) noexcept;
+  bool back_out_of_bend(const Sensing& in, Outbox& out) noexcept;
+  // above_via point K in the sheet frame the goal is sent in (a `frame: world` point put into the
+  // tracked sheet's frame of IN; false without one). RT.
+  [[nodiscard]] bool above_via_in_sheet(int k, const Sensing& in, double p[3],
+                                        double q[4]) const noexcept;
   // The via points the pinch had passed when the fold aborted in the bend or the lay (0: not from
   // there).
   [[nodiscard]] int bend_passed() const noexcept;

@@ -18,6 +18,10 @@ struct SheetFrame {
 [[nodiscard]] bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept;
 // The world position of sheet-frame point P (u, v, -h: a fold file's point) in frame F.
 void sheet_to_world(const SheetFrame& f, const double p[3], double out[3]) noexcept;
+// World pose (P mm, quaternion Q [x y z w]) into frame F's coordinates (P_OUT, Q_OUT): the
+// inverse of sheet_to_world for a point, and for an orientation its turn seen from F.
+void world_to_sheet(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
+                    double q_out[4]) noexcept;
 // The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
 [[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
 // The crease of s nearest to the segment a-b (sheet mm, by the sum of its end points'

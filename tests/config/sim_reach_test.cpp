@@ -263,32 +263,52 @@ TEST_CASE("the arms' parked pose (sim_world's default): each index pad 300 mm ov
   }
 }
 
-TEST_CASE("from the parked pose, the pinching arm's grasp of the half fold passes arm_motion's path check") {
+TEST_CASE(
+    "from the parked pose, the pinching arm's grasp of the half fold passes arm_motion's path "
+    "check, at every yaw the world draws") {
   const robot::RobotModel m = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
   const fold::FoldSpec f = fold::load_fold_file(kConfig + "folds/half.yaml");
   const Layout l = layout();
   // The pinching hand, shaped: parked, through above_via to above the edge (approach limits),
   // round the overhang to the pinch (contact limits), the sheet where the shift puts it.
   // VIA false: straight from the parked pose to above the edge.
-  const KDL::Frame sheet = shifted_sheet(l, f, 0);
-  auto grasp = [&](bool via) {
+  // Every yaw the world draws (+-15 deg). above_via is a world pose (half.yaml, `frame: world`);
+  // TURNED: as a sheet point, turning with the sheet (at -15 deg out of reach: a trial, seed 14,
+  // -14.6 deg, unreachable at once).
+  const KDL::Frame nominal = shifted_sheet(l, f, 0);
+  KDL::Frame sheet = nominal;
+  auto grasp = [&](bool via, bool turned = false) {
     ArmIk ik(m, pinching(f));
     ArmIk::Joints q = parked(pinching(f));
     REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.grasp_tool), q, posture(f.prepinch_rad)));
     std::vector<KDL::Frame> to_above;
-    for (int k = 0; k < f.grasp_above_via_count && via; ++k)
-      to_above.push_back(sheet_goal(sheet, f.grasp_above_via_mm[k], f.grasp_above_via_orientation[k]));
+    for (int k = 0; k < f.grasp_above_via_count && via; ++k) {
+      const double* p = f.grasp_above_via_mm[k];
+      const double* r = f.grasp_above_via_orientation[k];
+      REQUIRE(f.grasp_above_via_world[k]);
+      const KDL::Frame world(KDL::Rotation::Quaternion(r[0], r[1], r[2], r[3]),
+                             KDL::Vector(p[0], p[1], p[2]) / 1000.0);
+      to_above.push_back(turned ? sheet * (nominal.Inverse() * world) : world);
+    }
     const KDL::Frame above = sheet_goal(sheet, f.grasp_above_mm, f.grasp_orientation);
     to_above.push_back(above);
     const int missed = path_failures(ik, q, ik.tool_pose(q), to_above, f.approach, "grasp above");
     if (missed > 0) return missed + f.grasp_path_count + 1;
     std::vector<KDL::Frame> path;
-    for (int k = 0; k < f.grasp_path_count; ++k) path.push_back(sheet_goal(sheet, f.grasp_path_mm[k], f.grasp_orientation));
+    for (int k = 0; k < f.grasp_path_count; ++k)
+      path.push_back(sheet_goal(sheet, f.grasp_path_mm[k], f.grasp_orientation));
     path.push_back(sheet_goal(sheet, f.grasp_at_mm, f.grasp_orientation));
     return path_failures(ik, q, above, path, f.contact, "grasp reach");
   };
   CHECK(grasp(true) == 0);
   CHECK(grasp(false) > 0);  // failing variant: the straight turn
+  for (const double yaw_deg : {-15.0, -10.0, -5.0, 5.0, 10.0, 15.0}) {
+    CAPTURE(yaw_deg);
+    sheet = shifted_sheet(l, f, yaw_deg * std::numbers::pi / 180.0);
+    CHECK(grasp(true) == 0);
+  }
+  sheet = shifted_sheet(l, f, -15.0 * std::numbers::pi / 180.0);
+  CHECK(grasp(true, true) > 0);  // failing variant: above_via turned with the sheet
 }
 
 // The open hand over the sheet at the shift's contact (the sequence's first touch): how far

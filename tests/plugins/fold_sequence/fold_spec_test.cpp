@@ -76,8 +76,10 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.release_stiffness[15] == doctest::Approx(0.5));  // the thumb soft while it opens
   CHECK(h.release_stiffness[3] == doctest::Approx(2.0));
   REQUIRE(h.grasp_above_via_count == 1);
-  CHECK(h.grasp_above_via_mm[0][2] == -300.0);
-  CHECK(h.grasp_above_via_orientation[0][1] == -0.85576);
+  CHECK(h.grasp_above_via_world[0]);  // frame: world, its z up as given
+  CHECK(h.grasp_above_via_mm[0][0] == 200.0);
+  CHECK(h.grasp_above_via_mm[0][2] == 300.0);
+  CHECK(h.grasp_above_via_orientation[0][1] == 0.50756);
   REQUIRE(h.grasp_path_count == 2);
   CHECK(h.grasp_path_mm[1][1] == 282.5);
   CHECK(h.grasp_path_mm[1][2] == 35.5);  // 35.5 mm under the sheet: +z
@@ -176,8 +178,14 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
   }
   SUBCASE("an above_via point without its orientation") {
     const std::string e =
-        error_of(variant(", orientation: [0.08625, -0.85576, 0.05114, 0.50756]}", "}"));
+        error_of(variant(", orientation: [0.05114, 0.50756, -0.08625, 0.85576]}", "}"));
     CHECK(e.find("fold.grasp.above_via[0].orientation: required") != std::string::npos);
+  }
+  SUBCASE("an above_via point in an unknown frame") {
+    const std::string e =
+        error_of(variant("{frame: world, at_mm: [200", "{frame: table, at_mm: [200"));
+    CHECK(e.find("fold.grasp.above_via[0].frame: expected sheet or world, got 'table'") !=
+          std::string::npos);
   }
   SUBCASE("a prepinch posture of the wrong length") {
     const std::string e = error_of(variant("  prepinch_rad: [0, 0,", "  prepinch_rad: [0,"));

@@ -107,3 +107,34 @@ TEST_CASE("the model's crease nearest to the intended line, in the line's direct
   CHECK(b[0] == 210);
   CHECK(b[1] == 150);
 }
+
+// A fold file's world-frame point (grasp above_via, `frame: world`) goes out in the sheet frame:
+// world_to_sheet inverts sheet_to_world, and turns a world orientation into the frame's. The
+// simulated robot's sheet as laid (corner (0, 0) at (105, -148.5), u along -x, v along +y): the
+// half fold's above_via, given in the world as (200, -150, 300) mm, is the sheet point
+// (-95, -1.5, -300) with the orientation the file gave before in the sheet frame.
+TEST_CASE("world_to_sheet: a world pose in the sheet frame, the inverse of sheet_to_world") {
+  const auto s = sheet(3, 3, 105, -148.5, std::numbers::pi);  // u along -x, v along +y
+  SheetFrame f;
+  REQUIRE(sheet_frame(*s, f));
+  const double w[3] = {200, -150, 300}, qw[4] = {0.05114, 0.50756, -0.08625, 0.85576};
+  double p[3], q[4];
+  world_to_sheet(f, w, qw, p, q);
+  CHECK(p[0] == doctest::Approx(-95.0));
+  CHECK(p[1] == doctest::Approx(-1.5));
+  CHECK(p[2] == doctest::Approx(-300.0));
+  const double was[4] = {0.08625, -0.85576, 0.05114, 0.50756};  // the same pose as a sheet point
+  const double sign = q[3] * was[3] < 0 ? -1.0 : 1.0;           // q and -q are one turn
+  for (int c = 0; c < 4; ++c) CHECK(sign * q[c] == doctest::Approx(was[c]).epsilon(1e-4));
+  double back[3];
+  sheet_to_world(f, p, back);
+  for (int c = 0; c < 3; ++c) CHECK(back[c] == doctest::Approx(w[c]));
+  // Turned 15 deg more, the same world pose is another sheet pose.
+  const auto t = sheet(3, 3, 105, -148.5, std::numbers::pi + 15 * std::numbers::pi / 180);
+  SheetFrame g;
+  REQUIRE(sheet_frame(*t, g));
+  world_to_sheet(g, w, qw, p, q);
+  sheet_to_world(g, p, back);
+  for (int c = 0; c < 3; ++c) CHECK(back[c] == doctest::Approx(w[c]));
+  CHECK(std::fabs(p[1] + 1.5) > 20.0);  // 95 mm out along u, turned 15 deg: 24.6 mm across
+}
