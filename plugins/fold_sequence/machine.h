@@ -94,8 +94,8 @@ struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
   // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
-  // park in joint space, halved while out of reach); 6: aborted_from
-  static constexpr std::uint32_t kVersion = 6;
+  // park in joint space, halved while out of reach); 6: aborted_from; 7: pinch_off_since_ns
+  static constexpr std::uint32_t kVersion = 7;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
