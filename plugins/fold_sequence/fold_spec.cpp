@@ -63,8 +63,10 @@ void sheet_point(const Params& p, const char* key, double* out) {
 }
 
 // The grasp's list KEY of at most kMaxGraspPath `{at_mm}` points on the way to BEFORE, each
-// with its (required) `orientation` when ORIENTATION is given; returns how many.
-int grasp_points(const Params& p, const char* key, const char* before, double (*mm)[3], double (*orientation)[4]) {
+// with its (required) `orientation` when ORIENTATION is given, and its `frame` (sheet, the
+// default, or world: at_mm is then x, y, z up) when WORLD is; returns how many.
+int grasp_points(const Params& p, const char* key, const char* before, double (*mm)[3],
+                 double (*orientation)[4], bool* world = nullptr) {
   const std::vector<Params> list = p.list(key);
   if (list.size() > static_cast<std::size_t>(kMaxGraspPath))
     p.fail(key, "expected at most " + std::to_string(kMaxGraspPath) + " points before " + before);
@@ -73,6 +75,12 @@ int grasp_points(const Params& p, const char* key, const char* before, double (*
     const Params& v = list[static_cast<std::size_t>(i)];
     sheet_point(v, "at_mm", mm[i]);
     if (orientation != nullptr) quaternion(v, "orientation", orientation[i], true);
+    if (world == nullptr) continue;
+    const std::string frame = v.get<std::string>("frame", "sheet");
+    if (frame != "sheet" && frame != "world")
+      v.fail("frame", "expected sheet or world, got '" + frame + "'");
+    world[i] = frame == "world";
+    if (world[i]) mm[i][2] = -mm[i][2];  // z up as given
   }
   return n;
 }
@@ -217,20 +225,8 @@ void read(const Params& p, FoldSpec& f) {
   f.grasp_tool = tool(b, "tool", 4);
   f.pinch_fingers = fingers(b, "pinch_fingers", 0x11);
   f.pinch_force_n = b.get_in_range<double>("pinch_force_n", 0.2, 0.01, 10.0);
-  f.grasp_above_via_count =
-      grasp_points(b, "above_via", "above_mm", f.grasp_above_via_mm, f.grasp_above_via_orientation);
-  {
-    const std::vector<Params> vias = b.list("above_via");
-    for (int i = 0; i < f.grasp_above_via_count; ++i) {
-      const Params& v = vias[static_cast<std::size_t>(i)];
-      const std::string frame = v.get<std::string>("frame", "sheet");
-      if (frame != "sheet" && frame != "world")
-        v.fail("frame", "expected sheet or world, got '" + frame + "'");
-      f.grasp_above_via_world[i] = frame == "world";
-      if (f.grasp_above_via_world[i])
-        f.grasp_above_via_mm[i][2] = -f.grasp_above_via_mm[i][2];  // z up as given
-    }
-  }
+  f.grasp_above_via_count = grasp_points(b, "above_via", "above_mm", f.grasp_above_via_mm,
+                                         f.grasp_above_via_orientation, f.grasp_above_via_world);
   sheet_point(b, "above_mm", f.grasp_above_mm);
   f.grasp_path_count = grasp_points(b, "path", "at_mm", f.grasp_path_mm, nullptr);
   sheet_point(b, "at_mm", f.grasp_at_mm);

@@ -1,5 +1,6 @@
 #include "plugins/fold_sequence/sheet_geometry.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -31,34 +32,14 @@ void sheet_to_world(const SheetFrame& f, const double p[3], double out[3]) noexc
 
 void world_to_sheet(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
                     double q_out[4]) noexcept {
-  const double d[3] = {p[0] - f.origin[0], p[1] - f.origin[1], p[2] - f.origin[2]};
-  p_out[0] = f.x[0] * d[0] + f.x[1] * d[1] + f.x[2] * d[2];
-  p_out[1] = f.y[0] * d[0] + f.y[1] * d[1] + f.y[2] * d[2];
-  p_out[2] = f.z[0] * d[0] + f.z[1] * d[1] + f.z[2] * d[2];
-  // The frame's rotation (columns x, y, z) as a quaternion (Shepperd), then q_out = conj(r) q.
-  const double m00 = f.x[0], m01 = f.y[0], m02 = f.z[0];
-  const double m10 = f.x[1], m11 = f.y[1], m12 = f.z[1];
-  const double m20 = f.x[2], m21 = f.y[2], m22 = f.z[2];
-  double r[4];  // x y z w
-  const double tr = m00 + m11 + m22;
-  if (tr > 0) {
-    const double s = 2.0 * std::sqrt(tr + 1.0);
-    r[3] = 0.25 * s, r[0] = (m21 - m12) / s, r[1] = (m02 - m20) / s, r[2] = (m10 - m01) / s;
-  } else if (m00 > m11 && m00 > m22) {
-    const double s = 2.0 * std::sqrt(1.0 + m00 - m11 - m22);
-    r[3] = (m21 - m12) / s, r[0] = 0.25 * s, r[1] = (m01 + m10) / s, r[2] = (m02 + m20) / s;
-  } else if (m11 > m22) {
-    const double s = 2.0 * std::sqrt(1.0 + m11 - m00 - m22);
-    r[3] = (m02 - m20) / s, r[0] = (m01 + m10) / s, r[1] = 0.25 * s, r[2] = (m12 + m21) / s;
-  } else {
-    const double s = 2.0 * std::sqrt(1.0 + m22 - m00 - m11);
-    r[3] = (m10 - m01) / s, r[0] = (m02 + m20) / s, r[1] = (m12 + m21) / s, r[2] = 0.25 * s;
-  }
-  const double a[4] = {-r[0], -r[1], -r[2], r[3]};  // conj(r)
-  q_out[0] = a[3] * q[0] + a[0] * q[3] + a[1] * q[2] - a[2] * q[1];
-  q_out[1] = a[3] * q[1] - a[0] * q[2] + a[1] * q[3] + a[2] * q[0];
-  q_out[2] = a[3] * q[2] + a[0] * q[1] - a[1] * q[0] + a[2] * q[3];
-  q_out[3] = a[3] * q[3] - a[0] * q[0] - a[1] * q[1] - a[2] * q[2];
+  Eigen::Matrix3d r;  // the frame's rotation: its axes as columns
+  r << f.x[0], f.y[0], f.z[0], f.x[1], f.y[1], f.z[1], f.x[2], f.y[2], f.z[2];
+  const Eigen::Vector3d d = r.transpose() * (Eigen::Vector3d(p[0], p[1], p[2]) -
+                                             Eigen::Map<const Eigen::Vector3d>(f.origin));
+  const Eigen::Quaterniond turn =
+      Eigen::Quaterniond(r).conjugate() * Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
+  for (int c = 0; c < 3; ++c) p_out[c] = d[c];
+  q_out[0] = turn.x(), q_out[1] = turn.y(), q_out[2] = turn.z(), q_out[3] = turn.w();
 }
 
 bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept {
