@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <numbers>
 #include <set>
 #include <stdexcept>
 #include <thread>
@@ -254,8 +255,13 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
           if (have_start_truth && truth->poll().has_data())
             x.frame_moved_mm = frame_error_mm(*start_truth, truth->value());
           if (world_state->poll().has_data())
-            for (int h = 0; h < 2; ++h)
-              x.ff_z_mm[h] = world_state->value().hand[h].tip[0].position_mm[2];
+            for (int h = 0; h < 2; ++h) {
+              const WorldHand& wh = world_state->value().hand[h];
+              x.ff_z_mm[h] = wh.tip[0].position_mm[2];
+              x.palm_contact[h] = wh.palm_contact;
+              x.wrist_deflection_deg[h] =
+                  std::hypot(wh.deflection_rad[0], wh.deflection_rad[1]) * 180.0 / std::numbers::pi;
+            }
           double g[3];
           if (truth->poll().has_data() &&
               fold::node_at(truth->value(), spec.grasp_at_mm[0], spec.grasp_at_mm[1], g))
@@ -425,7 +431,11 @@ nlohmann::json to_json(const TrialResult& r) {
                            {"grasp_tracked_z_mm", nlohmann::json::array()},
                            {"frame_moved_mm", nlohmann::json::array()},
                            {"ff_r_z_mm", nlohmann::json::array()},
-                           {"ff_l_z_mm", nlohmann::json::array()}};
+                           {"ff_l_z_mm", nlohmann::json::array()},
+                           {"palm_r", nlohmann::json::array()},
+                           {"palm_l", nlohmann::json::array()},
+                           {"wrist_r_deg", nlohmann::json::array()},
+                           {"wrist_l_deg", nlohmann::json::array()}};
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
@@ -447,6 +457,10 @@ nlohmann::json to_json(const TrialResult& r) {
     series["frame_moved_mm"].push_back(num(x.frame_moved_mm));
     series["ff_r_z_mm"].push_back(num(x.ff_z_mm[0]));
     series["ff_l_z_mm"].push_back(num(x.ff_z_mm[1]));
+    series["palm_r"].push_back(x.palm_contact[0]);
+    series["palm_l"].push_back(x.palm_contact[1]);
+    series["wrist_r_deg"].push_back(num(x.wrist_deflection_deg[0]));
+    series["wrist_l_deg"].push_back(num(x.wrist_deflection_deg[1]));
     series["grasp_z_mm"].push_back(num(x.grasp_z_mm));
     series["grasp_tracked_z_mm"].push_back(num(x.grasp_tracked_z_mm));
     series["onsets_r"].push_back(x.contact_onsets[0]);
@@ -547,6 +561,12 @@ TrialResult from_json(const nlohmann::json& j) {
       if (x.contains("ff_r_z_mm")) {
         v.ff_z_mm[0] = num(x.at("ff_r_z_mm")[k]);
         v.ff_z_mm[1] = num(x.at("ff_l_z_mm")[k]);
+      }
+      if (x.contains("palm_r")) {
+        v.palm_contact[0] = x.at("palm_r")[k].get<int>();
+        v.palm_contact[1] = x.at("palm_l")[k].get<int>();
+        v.wrist_deflection_deg[0] = num(x.at("wrist_r_deg")[k]);
+        v.wrist_deflection_deg[1] = num(x.at("wrist_l_deg")[k]);
       }
       if (x.contains("grasp_z_mm")) {
         v.grasp_z_mm = num(x.at("grasp_z_mm")[k]);

@@ -80,6 +80,12 @@ struct SeriesSample {
   // contact or not: where a descent that touched nothing ended.
   double ff_z_mm[2] = {std::numeric_limits<double>::quiet_NaN(),
                        std::numeric_limits<double>::quiet_NaN()};
+  // Each hand's palm touching the sheet or the table (world; -1: no world state yet), and its
+  // wrist's deflection from the commanded angles (the norm of WRJ2's and WRJ1's, deg): a hand
+  // turned by something other than a fingertip (the palm, a finger's back) pressing.
+  int palm_contact[2] = {-1, -1};
+  double wrist_deflection_deg[2] = {std::numeric_limits<double>::quiet_NaN(),
+                                    std::numeric_limits<double>::quiet_NaN()};
 };
 inline constexpr double kSeriesS = 0.02;
 

@@ -274,7 +274,9 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
                       6.5,
                       96.0,
                       41.5,
-                      {33.0, std::nan("")}});
+                      {33.0, std::nan("")},
+                      {1, -1},
+                      {12.25, std::nan("")}});
   b.score.stretch_at_mm[0] = 52.5;
   b.score.stretch_at_mm[1] = 7.425;
   b.sheet_nodes_u = 2;
@@ -313,4 +315,9 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(back.series[0].grasp_tracked_z_mm == 41.5);
   CHECK(back.series[0].ff_z_mm[0] == 33.0);  // the right index pad's height; the left's unknown
   CHECK(std::isnan(back.series[0].ff_z_mm[1]));
+  // ... and the palms' contacts and the wrists' deflections (the left: no world state yet).
+  CHECK(back.series[0].palm_contact[0] == 1);
+  CHECK(back.series[0].palm_contact[1] == -1);
+  CHECK(back.series[0].wrist_deflection_deg[0] == 12.25);
+  CHECK(std::isnan(back.series[0].wrist_deflection_deg[1]));
 }
