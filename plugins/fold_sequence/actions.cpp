@@ -51,24 +51,34 @@ void Machine::arm_path(int side, std::uint8_t tool, std::uint8_t frame, int n, c
   if (goal == nullptr) return;
   ArmGoal& g = *goal;
   n = n < 1 ? 1 : (n > ArmGoal::kMaxPoints ? ArmGoal::kMaxPoints : n);
+  const bool held = frame == ArmGoal::sheet && m_.frame_held != 0 && uses_held_frame(m_.leaf);
   g.kind = ArmGoal::move;
   g.tool = tool;
-  g.frame = frame;
+  g.frame = held ? std::uint8_t{ArmGoal::world} : frame;
   g.point_count = static_cast<std::uint8_t>(n);
   g.stop_on = stop_fingers != 0 ? ArmGoal::contact_onset : ArmGoal::stop_none;
   g.stop_fingers = stop_fingers != 0 ? stop_fingers : 0x1f;
   set_limits(g, lim);
   for (int k = 0; k < n; ++k) {
+    if (held) {
+      sheet_to_world(m_.held_frame, path_mm[k], orientation[k], g.position_mm[k], g.orientation[k]);
+      continue;
+    }
     for (int c = 0; c < 3; ++c) g.position_mm[k][c] = path_mm[k][c];
     for (int c = 0; c < 4; ++c) g.orientation[k][c] = orientation[k][c];
   }
   m_.arm_id[side] = g.id;
   m_.arm_sent_ns[side] = m_.last_ns;
   m_.arm_has_target[side] = 1;
-  m_.arm_frame[side] = frame;
+  m_.arm_frame[side] = g.frame;
   m_.arm_tool[side] = tool;
-  for (int c = 0; c < 3; ++c) m_.arm_target[side][c] = path_mm[n - 1][c];
-  for (int c = 0; c < 4; ++c) m_.arm_orientation[side][c] = orientation[n - 1][c];
+  for (int c = 0; c < 3; ++c) m_.arm_target[side][c] = g.position_mm[n - 1][c];
+  for (int c = 0; c < 4; ++c) m_.arm_orientation[side][c] = g.orientation[n - 1][c];
+}
+
+bool Machine::uses_held_frame(S s) noexcept {
+  return is_within(s, S::fixate_layer) || is_within(s, S::refixate) || is_within(s, S::swipe) ||
+         is_within(s, S::harden);
 }
 
 void Machine::arm_stop(int side, Outbox& out) noexcept {
@@ -344,6 +354,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       for (int s2 = 0; s2 < 2; ++s2) m_.inhibits0[s2] = in.hand[s2] != nullptr ? in.hand[s2]->inhibits : 0;
       m_.via = 0;
       m_.vision_bad_since_ns = 0;
+      m_.frame_held = 0;
       m_.abort_reason = Reason::none;
       break;
     case S::shift_approach:
@@ -395,6 +406,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       }
       out.has_crease = true;
       m_.crease_count0 = in.sheet != nullptr ? in.sheet->crease_count : 0;
+      m_.frame_held = in.sheet != nullptr && sheet_frame(*in.sheet, m_.held_frame) ? 1 : 0;
       break;
     case S::follow_via:
       if (m_.self_entry) ++m_.via;  // the next via point; re-entered on resume: the same one

@@ -26,6 +26,7 @@
 #include "core/port_types/sequence_status.h"
 #include "core/port_types/sheet_state.h"
 #include "plugins/fold_sequence/fold_spec.h"
+#include "plugins/fold_sequence/sheet_geometry.h"
 #include "plugins/fold_sequence/states.h"
 
 namespace crease::fold {
@@ -94,8 +95,9 @@ struct Memory {
   static constexpr std::uint32_t kTag = 0x464f4c44;  // "FOLD"
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
   // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
-  // park in joint space, halved while out of reach); 6: aborted_from; 7: pinch_off_since_ns
-  static constexpr std::uint32_t kVersion = 7;
+  // park in joint space, halved while out of reach); 6: aborted_from; 7: pinch_off_since_ns;
+  // 8: held_frame
+  static constexpr std::uint32_t kVersion = 8;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -148,6 +150,13 @@ struct Memory {
   std::uint32_t crease_count0 = 0;    // sheet_state's creases when the crease was sent
   std::uint64_t sheet_step0 = 0;      // sheet_state's step when the memorize was sent
   double harden_a[2] = {}, harden_b[2] = {};  // the hardening stroke (sheet mm), from the model
+  // The tracked sheet's frame when the bend began (frame_held 0: there was none). From the lay
+  // on the near half lies under the bent layer, its markers hidden, and the model's frame
+  // drifts while the fixing hand holds the world's half still (trials: 12-31 mm, the world's
+  // 1.5-10 mm): the goals of the lay, the refixation, the swipe and the hardening are put into
+  // the world by this frame (uses_held_frame).
+  std::uint8_t frame_held = 0;
+  SheetFrame held_frame{};
 };
 
 class Machine {
@@ -234,6 +243,9 @@ class Machine {
   void approach(int side, const ContactStep& c, Outbox& out) noexcept;     // above c.at
   void descend(int side, const ContactStep& c, Outbox& out) noexcept;      // down to c.at, stop on contact
   void push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) noexcept;
+
+  // State S sends its sheet-frame goals as world goals by Memory::held_frame (when one was held).
+  [[nodiscard]] static bool uses_held_frame(S s) noexcept;
 
   const FoldSpec& spec_;
   Memory m_;

@@ -30,10 +30,25 @@ void sheet_to_world(const SheetFrame& f, const double p[3], double out[3]) noexc
   for (int c = 0; c < 3; ++c) out[c] = f.origin[c] + f.x[c] * p[0] + f.y[c] * p[1] + f.z[c] * p[2];
 }
 
+namespace {
+Eigen::Matrix3d rotation(const SheetFrame& f) noexcept {  // the frame's axes as columns
+  Eigen::Matrix3d r;
+  r << f.x[0], f.y[0], f.z[0], f.x[1], f.y[1], f.z[1], f.x[2], f.y[2], f.z[2];
+  return r;
+}
+}  // namespace
+
+void sheet_to_world(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
+                    double q_out[4]) noexcept {
+  sheet_to_world(f, p, p_out);
+  const Eigen::Quaterniond turn =
+      Eigen::Quaterniond(rotation(f)) * Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
+  q_out[0] = turn.x(), q_out[1] = turn.y(), q_out[2] = turn.z(), q_out[3] = turn.w();
+}
+
 void world_to_sheet(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
                     double q_out[4]) noexcept {
-  Eigen::Matrix3d r;  // the frame's rotation: its axes as columns
-  r << f.x[0], f.y[0], f.z[0], f.x[1], f.y[1], f.z[1], f.x[2], f.y[2], f.z[2];
+  const Eigen::Matrix3d r = rotation(f);
   const Eigen::Vector3d d = r.transpose() * (Eigen::Vector3d(p[0], p[1], p[2]) -
                                              Eigen::Map<const Eigen::Vector3d>(f.origin));
   const Eigen::Quaterniond turn =

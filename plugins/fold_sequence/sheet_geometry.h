@@ -22,6 +22,10 @@ void sheet_to_world(const SheetFrame& f, const double p[3], double out[3]) noexc
 // inverse of sheet_to_world for a point, and for an orientation its turn seen from F.
 void world_to_sheet(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
                     double q_out[4]) noexcept;
+// Sheet-frame pose (P mm, Q) of frame F into the world: sheet_to_world for the point, and the
+// orientation turned by F's rotation (the inverse of world_to_sheet).
+void sheet_to_world(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
+                    double q_out[4]) noexcept;
 // The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
 [[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
 // The crease of s nearest to the segment a-b (sheet mm, by the sum of its end points'

@@ -46,6 +46,25 @@ const std::vector<std::string> kRetreat = {"abort/stop", "abort/open", "abort/li
 
 bool near(double a, double b, double tol = 1e-3) { return std::abs(a - b) <= tol; }
 
+// Point K of goal G (and its turn) in the frame of the tracked sheet S: a sheet-frame goal as
+// sent, a world goal (from the lay on: the frame held when the bend began) put into it.
+struct InSheet {
+  double p[3];
+  double q[4];
+};
+InSheet in_sheet(const ArmGoal& g, const crease::SheetState& s, int k = 0) {
+  InSheet r{};
+  if (g.frame == ArmGoal::sheet) {
+    for (int c = 0; c < 3; ++c) r.p[c] = g.position_mm[k][c];
+    for (int c = 0; c < 4; ++c) r.q[c] = g.orientation[k][c];
+    return r;
+  }
+  crease::fold::SheetFrame f;
+  REQUIRE(crease::fold::sheet_frame(s, f));
+  crease::fold::world_to_sheet(f, g.position_mm[k], g.orientation[k], r.p, r.q);
+  return r;
+}
+
 // After an abort: both hands' last goal opens them (posture, the fold's open targets: zeros),
 // no force goal reached a hand after the abort began, both arms were stopped and parked.
 void check_retreat(const Rig& r, long abort_cycle) {
@@ -216,26 +235,32 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(near(pinching[5]->arm_goal.orientation[0][0], -0.52423));  // the pinch turned 90 deg with the sheet
   // (d) the pinch lays the layer 22 mm over the stack, turned as the last via point.
   REQUIRE(pinching.size() >= 12);
-  const ArmGoal& lay = pinching[10]->arm_goal;
-  CHECK(near(lay.position_mm[0][1], 14.5));
-  CHECK(near(lay.position_mm[0][2], -22.0));
-  CHECK(near(lay.orientation[0][0], -0.40748));
+  // From the lay on, the goals are world goals: sheet-frame points put into the world by the
+  // tracked frame held when the bend began (the rig's sheet has not moved since).
+  const crease::SheetState& sh = r.sheet();
+  const ArmGoal& lay_goal = pinching[10]->arm_goal;
+  CHECK(lay_goal.frame == ArmGoal::world);
+  const InSheet lay = in_sheet(lay_goal, sh);
+  CHECK(near(lay.p[1], 14.5));
+  CHECK(near(lay.p[2], -22.0));
+  CHECK(near(std::abs(lay.q[0]), 0.40748));  // the turn's sign is the quaternion's choice
   // (e) the fixing hand, pressing 0.5 N, slides out from under the layer along the table, off the
   // sheet's side, before it opens and lands on both layers; the pinch has not let go meanwhile.
   const auto fix_after = r.all(kFix, Sent::arm, pinching[10]->cycle);
   REQUIRE(fix_after.size() >= 4);
-  const ArmGoal& out = fix_after[0]->arm_goal;
-  CHECK(near(out.position_mm[0][0], 255.0));
-  CHECK(near(out.position_mm[0][1], 88.5));
-  CHECK(near(out.position_mm[0][2], 0.0));
-  CHECK(out.stop_on == ArmGoal::stop_none);
+  const ArmGoal& out_goal = fix_after[0]->arm_goal;
+  const InSheet out = in_sheet(out_goal, sh);
+  CHECK(near(out.p[0], 255.0));
+  CHECK(near(out.p[1], 88.5));
+  CHECK(near(out.p[2], 0.0));
+  CHECK(out_goal.stop_on == ArmGoal::stop_none);
   const auto fix_hand_after = r.all(kFix, Sent::hand, pinching[10]->cycle);
   REQUIRE(fix_hand_after.size() >= 2);
   CHECK(fix_hand_after[0]->hand_goal.mode == HandMode::force);
   CHECK(fix_hand_after[0]->hand_goal.force_n == 0.5f);
   CHECK(fix_hand_after[1]->hand_goal.mode == HandMode::posture);  // then it opens
   CHECK(fix_hand_after[1]->cycle >= fix_after[0]->cycle + r.move_cycles);
-  CHECK(near(fix_after[2]->arm_goal.position_mm[0][1], 40.0));  // over both layers
+  CHECK(near(in_sheet(fix_after[2]->arm_goal, sh).p[1], 40.0));  // over both layers
   // (f) once both layers are held, the pinch opens to prepinch (the thumb only), then its pads
   // leave the edge (straight up), then the hand opens.
   const auto pin_hand_after = r.all(kPin, Sent::hand, pinching[10]->cycle);
@@ -248,19 +273,21 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(pin_hand_after[0]->hand_goal.set_stiffness == 1);  // half.yaml's release_stiffness: a soft thumb
   CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[15] == doctest::Approx(0.5));
   CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[0] == doctest::Approx(30.0));
-  const ArmGoal& withdraw = pinching[11]->arm_goal;
+  const InSheet withdraw = in_sheet(pinching[11]->arm_goal, sh);
   CHECK(pinching[11]->cycle >= pin_hand_after[0]->cycle + r.posture_cycles);
-  CHECK(near(withdraw.position_mm[0][1], 14.5));
-  CHECK(near(withdraw.position_mm[0][2], -37.0));  // straight up off the laid edge
+  CHECK(near(withdraw.p[1], 14.5));
+  CHECK(near(withdraw.p[2], -37.0));  // straight up off the laid edge
   CHECK(pin_hand_after[1]->cycle >= pinching[11]->cycle + r.move_cycles);
   for (float t : pin_hand_after[1]->hand_goal.target_rad) CHECK(t == 0.0f);  // open
   // (g) the hardening stroke along the model's crease, inset 10 mm, 4 mm onto the stack.
   const Sent* hs = nullptr;
   for (const Sent* s : pinching)
-    if (s->arm_goal.stop_on == ArmGoal::contact_onset && s->arm_goal.position_mm[0][1] < 146) hs = s;
+    if (s->arm_goal.stop_on == ArmGoal::contact_onset && in_sheet(s->arm_goal, sh).p[1] < 146)
+      hs = s;
   REQUIRE(hs != nullptr);
-  CHECK(near(hs->arm_goal.position_mm[0][0], 10.0));
-  CHECK(near(hs->arm_goal.position_mm[0][1], 144.5));
+  CHECK(hs->arm_goal.frame == ArmGoal::world);
+  CHECK(near(in_sheet(hs->arm_goal, sh).p[0], 10.0));
+  CHECK(near(in_sheet(hs->arm_goal, sh).p[1], 144.5));
   // (h) the model memorizes once; both hands end open; both arms park.
   int memorized = 0;
   for (const Sent& s : r.sent()) memorized += s.kind == Sent::memorize;
@@ -285,6 +312,46 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
         last_id = id;
       }
     }
+}
+
+TEST_CASE(
+    "from the lay on, goals stay where the sheet was when the bend began, though the model "
+    "drifts") {
+  // Under the laid layer the near half's markers are hidden and the model's frame drifts while
+  // the fixing hand holds the world's half (trials: 12-31 mm): the refixation, the swipe and the
+  // hardening aim where the sheet was seen last, not where the drifting model puts it.
+  Rig r;
+  start_and_run_to(r, "fold/bend/crease");
+  crease::fold::SheetFrame before;
+  REQUIRE(crease::fold::sheet_frame(r.sheet(), before));
+  const auto sheet_goals = r.all(kFix, Sent::arm);
+  REQUIRE(!sheet_goals.empty());
+  CHECK(sheet_goals.front()->arm_goal.frame == ArmGoal::sheet);  // before the bend: the live frame
+  REQUIRE(r.run_to("fold/refixate/slide_out"));
+  const long drifted_at = r.cycles();
+  r.drift(25.0, -20.0);
+  REQUIRE(r.run_to("done"));
+  const auto after = r.all(kFix, Sent::arm, drifted_at);
+  REQUIRE(after.size() >= 3);
+  const Sent* approach = nullptr;  // the refixation's approach: above (165, 40), 30 mm up
+  for (const Sent* x : after)
+    if (x->arm_goal.frame == ArmGoal::world && x->arm_goal.position_mm[0][2] > 20 &&
+        approach == nullptr && x->arm_goal.point_count == 1 &&
+        x->arm_goal.stop_on == ArmGoal::stop_none && x->arm_goal.kind == ArmGoal::move &&
+        x->arm_goal.position_mm[0][2] < 100)
+      approach = x;
+  REQUIRE(approach != nullptr);
+  double p[3], q[4];
+  crease::fold::world_to_sheet(before, approach->arm_goal.position_mm[0],
+                               approach->arm_goal.orientation[0], p, q);
+  CHECK(near(p[0], 165.0));
+  CHECK(near(p[1], 40.0));
+  CHECK(near(p[2], -30.0));
+  // In the drifted model's frame the same goal is 25 mm and 20 mm off: a goal in the live frame
+  // would have followed the drift.
+  const InSheet drifted = in_sheet(approach->arm_goal, r.sheet());
+  CHECK(std::hypot(drifted.p[0] - 165.0, drifted.p[1] - 40.0) ==
+        doctest::Approx(std::hypot(25.0, 20.0)).epsilon(1e-3));
 }
 
 TEST_CASE("the diagonal fold runs from its file alone: its crease, its via points") {

@@ -151,6 +151,17 @@ class Rig {
   }
 
   const SequenceStatus& status() const { return status_in_.value(); }
+  // The tracked sheet drifting (the model's estimate, not the world): every node moved by
+  // (dx, dy) mm in the world.
+  void drift(double dx, double dy) {
+    SheetState& sh = *sheet_;
+    for (int k = 0; k < sh.nodes_u * sh.nodes_v; ++k) {
+      sh.position_mm[k][0] += static_cast<float>(dx);
+      sh.position_mm[k][1] += static_cast<float>(dy);
+    }
+  }
+  // The tracked sheet the rig publishes.
+  const SheetState& sheet() const { return *sheet_; }
   const std::vector<std::string>& paths() const { return paths_; }
   const std::vector<Sent>& sent() const { return sent_; }
   std::uint64_t allocations() const { return allocations_; }
@@ -215,9 +226,14 @@ class Rig {
   // nearest the goal's u, v when the pinch first carries): the tracked grasp point follows the
   // pinch as the model would (pinch_carries false: it stays, as after a lost pinch).
   void carry(int s, const ArmGoal& g) {
-    if (!pinch_carries || !hands_[s].pinch || g.frame != ArmGoal::sheet || g.point_count == 0)
-      return;
+    if (!pinch_carries || !hands_[s].pinch || g.point_count == 0) return;
     const double* p = g.position_mm[g.point_count - 1];
+    if (g.frame == ArmGoal::world && carried_ >= 0) {  // a goal in the frame held from the bend
+      for (int c = 0; c < 3; ++c) sheet_->position_mm[carried_][c] = static_cast<float>(p[c]);
+      carried_new_ = true;
+      return;
+    }
+    if (g.frame != ArmGoal::sheet) return;
     crease::fold::SheetFrame f;
     if (!crease::fold::sheet_frame(*sheet_, f)) return;
     if (carried_ < 0)
@@ -329,8 +345,9 @@ class Rig {
         a.st.reason = 0;
         a.left = move_cycles;
         a.stall = stalls(s, g, index);
-        const bool up = (g.frame == ArmGoal::sheet && g.position_mm[0][2] < -1) ||
-                        (g.frame == ArmGoal::measured && g.position_mm[0][2] > 1);
+        const bool up =
+            (g.frame == ArmGoal::sheet && g.position_mm[0][2] < -1) ||
+            (g.frame != ArmGoal::sheet && g.position_mm[0][2] > 1);  // world: the table at 0
         if (g.stop_on == ArmGoal::stop_none && up) {
           contact_[s].in_contact = 0;  // lifting off
           contact_[s].fingers = 0;

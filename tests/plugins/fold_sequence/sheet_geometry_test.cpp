@@ -138,3 +138,25 @@ TEST_CASE("world_to_sheet: a world pose in the sheet frame, the inverse of sheet
   for (int c = 0; c < 3; ++c) CHECK(back[c] == doctest::Approx(w[c]));
   CHECK(std::fabs(p[1] + 1.5) > 20.0);  // 95 mm out along u, turned 15 deg: 24.6 mm across
 }
+
+// The sequence's goals from the lay on go out as world poses (the frame held from the bend):
+// sheet_to_world of a pose is world_to_sheet's inverse, orientation included.
+TEST_CASE("sheet_to_world: a sheet pose in the world, the inverse of world_to_sheet") {
+  const auto s = sheet(3, 3, 105, -148.5, std::numbers::pi + 0.2);
+  SheetFrame f;
+  REQUIRE(sheet_frame(*s, f));
+  const double p[3] = {165, 40, -30}, q[4] = {0.18301, -0.18301, 0.68301, 0.68301};
+  double w[3], qw[4], back[3], qb[4];
+  sheet_to_world(f, p, q, w, qw);
+  CHECK(w[2] == doctest::Approx(30.0));  // 30 mm over the table: the frame's z points into it
+  world_to_sheet(f, w, qw, back, qb);
+  for (int c = 0; c < 3; ++c) CHECK(back[c] == doctest::Approx(p[c]));
+  const double sign = qb[3] * q[3] < 0 ? -1.0 : 1.0;
+  for (int c = 0; c < 4; ++c) CHECK(sign * qb[c] == doctest::Approx(q[c]).epsilon(1e-9));
+  // The identity (a pad pressing down onto the sheet) is the frame's own turn: its z into the
+  // table.
+  const double id[4] = {0, 0, 0, 1};
+  sheet_to_world(f, p, id, w, qw);
+  const double z_down = 1.0 - 2.0 * (qw[0] * qw[0] + qw[1] * qw[1]);  // R(q)'s zz
+  CHECK(z_down == doctest::Approx(-1.0));
+}
