@@ -320,15 +320,15 @@ struct Clearance {
   double shell_over_cover_mm = 0;
   std::string lowest_shell;
 };
-Clearance contact_clearance(const robot::RobotModel& m, const fold::FoldSpec& f, const double orientation[4]) {
+Clearance contact_clearance(const robot::RobotModel& m, Side side, const fold::ContactStep& step,
+                            const double orientation[4]) {
   const Layout l = layout();
   const KDL::Frame sheet = sheet_frame(l, 0, 0, 0);
-  const double contact[3] = {f.shift.at_mm[0], f.shift.at_mm[1], 0.0};
-  const Side side = fixing(f);
+  const double contact[3] = {step.at_mm[0], step.at_mm[1], 0.0};
   const int si = static_cast<int>(side);
   ArmIk ik(m, side);
   const Hand open{};  // the sequence's open hand
-  REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.shift.tool), ik.options().rest_rad, open));
+  REQUIRE(ik.set_tool(static_cast<ToolFrame>(step.tool), ik.options().rest_rad, open));
   ArmIk::Joints q{};
   REQUIRE(ik.solve(sheet_goal(sheet, contact, orientation), ik.options().rest_rad, q).converged);
   world::WorldParams p;
@@ -359,17 +359,43 @@ TEST_CASE("at the shift's contact the open hand touches the sheet with its finge
   const robot::RobotModel m = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
   const fold::FoldSpec f = fold::load_fold_file(kConfig + "folds/half.yaml");
   // As shipped: the palm pitched 30 deg (the fingers down, the wrist up).
-  const Clearance shipped = contact_clearance(m, f, f.shift.orientation);
+  const Clearance shipped = contact_clearance(m, fixing(f), f.shift, f.shift.orientation);
   MESSAGE("half: the lowest shell (" << shipped.lowest_shell << ") " << shipped.shell_over_cover_mm
                                      << " mm over the lowest fingertip cover");
   CHECK(shipped.shell_over_cover_mm > f.shift.contact_depth_mm);
   // Failing variant: the pad flat on the sheet, the fingers along world +y as shipped (turned
   // about the normal only): the forearm's flange shell, the thumb, wrist and palm hang below the pads.
   const double flat[4] = {0, 0, 0.70711, 0.70711};
-  const Clearance before = contact_clearance(m, f, flat);
+  const Clearance before = contact_clearance(m, fixing(f), f.shift, flat);
   MESSAGE("half, the pad flat: the lowest shell (" << before.lowest_shell << ") " << before.shell_over_cover_mm
                                                    << " mm over the lowest fingertip cover");
   CHECK(before.shell_over_cover_mm < 0.0);
+}
+
+// The pinching hand's touches after the fold (the swipe's, the hardening's): the open hand over
+// the stack by the crease, where the laid layer's loop stands. A trial (seed 15) with the pad flat
+// (as parked): the thumb's proximal phalanx, as low as the index pad, met the stack first, the
+// wrist turned 32 deg and the index pad rose 75 mm while the arm went down: the descent ended at
+// its depth untouched (`no_contact`).
+TEST_CASE(
+    "at the swipe's and the hardening's contact the pinching hand touches with its fingertip "
+    "covers only") {
+  const robot::RobotModel m = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
+  const fold::FoldSpec f = fold::load_fold_file(kConfig + "folds/half.yaml");
+  fold::ContactStep harden = f.harden;  // its stroke's start: the intended crease, inset and offset
+  harden.at_mm[0] = f.fold_line_mm[0][0] + f.harden_inset_mm;
+  harden.at_mm[1] = f.fold_line_mm[0][1] + f.harden_offset_mm;
+  for (const fold::ContactStep* step : {&f.swipe, static_cast<const fold::ContactStep*>(&harden)}) {
+    const Clearance c = contact_clearance(m, pinching(f), *step, step->orientation);
+    MESSAGE("half, pinching hand at ("
+            << step->at_mm[0] << ", " << step->at_mm[1] << "): the lowest shell (" << c.lowest_shell
+            << ") " << c.shell_over_cover_mm << " mm over the lowest fingertip cover");
+    CHECK(c.shell_over_cover_mm > step->contact_depth_mm);
+    // Failing variant: the pad flat, as parked.
+    const double flat[4] = {0, 0, 0.70711, 0.70711};
+    CHECK(contact_clearance(m, pinching(f), *step, flat).shell_over_cover_mm <
+          step->contact_depth_mm);
+  }
 }
 
 namespace {
