@@ -298,18 +298,23 @@ Reason Machine::fault(const Sensing& in) noexcept {
   // Off the way on every model state for pinch_lost_s: the tracker alone can put it there for a
   // moment (its error over a trial's frames reaches 30-60 mm at its worst).
   if (!seen) return Reason::none;  // a state without observations tells nothing either way
-  if (!pinch_lost(*sh)) {
+  bool judged = true;
+  const Reason off = grasp_off(*sh, judged);
+  if (!judged) {  // a model state from before the state's lag: the time off the way runs on
+  } else if (off == Reason::none) {
     m_.pinch_off_since_ns = 0;
   } else if (m_.pinch_off_since_ns == 0) {
     m_.pinch_off_since_ns = now;
   }
   if (m_.pinch_off_since_ns != 0 &&
       static_cast<double>(now - m_.pinch_off_since_ns) * 1e-9 >= spec_.pinch_lost_s)
-    return found("tracked grasp point off the pinch", Reason::pinch_lost);
+    return found(off == Reason::fold_lost ? "tracked grasp point off the laid layer"
+                                          : "tracked grasp point off the pinch",
+                 off);
   return Reason::none;
 }
 
-bool Machine::pinch_lost(const SheetState& sh) const noexcept {
+Reason Machine::grasp_off(const SheetState& sh, bool& judged) const noexcept {
   // The pinching tool's way in this state and the one before it: from the point before the one
   // it left, through the point it left (the grasp, or a via point), to the one it goes to; in the
   // sheet frame as the tracked sheet has it now. The way before too because the model's flap,
@@ -318,9 +323,29 @@ bool Machine::pinch_lost(const SheetState& sh) const noexcept {
   // kModelLagNs after the state began.
   constexpr std::int64_t kModelLagNs = 150'000'000;
   const bool lay = m_.leaf == S::layer_lay;
-  if (spec_.pinch_lost_mm <= 0 || (m_.leaf != S::follow_via && !lay) || spec_.via_count == 0 ||
-      sh.timestamp_ns < m_.leaf_since_ns + kModelLagNs)
-    return false;
+  // Once the pinch let go (swipe from its withdraw on, harden), the laid layer is held by the
+  // fixing hand alone and may spring back: the grasp point then lies far from where it was laid
+  // (lay_mm's u, v on the stack, in the frame the lay's goal went out in).
+  const bool laid = (is_within(m_.leaf, S::swipe) && m_.leaf != S::swipe_release) ||
+                    is_within(m_.leaf, S::harden);
+  judged = true;
+  if (spec_.pinch_lost_mm <= 0 || (m_.leaf != S::follow_via && !lay && !laid) ||
+      spec_.via_count == 0)
+    return Reason::none;
+  if (sh.timestamp_ns < m_.leaf_since_ns + kModelLagNs) {
+    judged = false;
+    return Reason::none;
+  }
+  if (laid) {
+    SheetFrame live;
+    double g[3], at[3];
+    if (!sheet_frame(sh, live) || !node_at(sh, spec_.grasp_at_mm[0], spec_.grasp_at_mm[1], g))
+      return Reason::none;
+    const double on_stack[3] = {spec_.lay_mm[0], spec_.lay_mm[1], 0.0};
+    sheet_to_world(m_.frame_held != 0 ? m_.held_frame : live, on_stack, at);
+    const double d = std::hypot(g[0] - at[0], g[1] - at[1], g[2] - at[2]);
+    return d > spec_.pinch_lost_mm ? Reason::fold_lost : Reason::none;
+  }
   const int k =
       lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count - 1);  // the point it goes to
   const auto point = [&](int i) {
@@ -329,12 +354,12 @@ bool Machine::pinch_lost(const SheetState& sh) const noexcept {
   SheetFrame f;
   double g[3], w[3][3];
   if (!sheet_frame(sh, f) || !node_at(sh, spec_.grasp_at_mm[0], spec_.grasp_at_mm[1], g))
-    return false;
+    return Reason::none;
   const int first = std::max(-1, k - 2);
   for (int i = first; i <= k; ++i) sheet_to_world(f, point(i), w[i - first]);
   double d = segment_distance(g, w[k - 1 - first], w[k - first]);
   if (k - first == 2) d = std::min(d, segment_distance(g, w[0], w[1]));
-  return d > spec_.pinch_lost_mm;
+  return d > spec_.pinch_lost_mm ? Reason::pinch_lost : Reason::none;
 }
 
 }  // namespace crease::fold

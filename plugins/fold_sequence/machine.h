@@ -187,8 +187,12 @@ class Machine {
   [[nodiscard]] bool holds(Ev ev, S owner, const Sensing& in) const noexcept;
   [[nodiscard]] bool passes(Guard g, const Sensing& in) const noexcept;
   [[nodiscard]] Reason fault(const Sensing& in) noexcept;  // Reason::none when all is well
-  // spec_.pinch_lost_mm's check on the tracked sheet SH (conditions.cpp).
-  [[nodiscard]] bool pinch_lost(const SheetState& sh) const noexcept;
+  // spec_.pinch_lost_mm's check on the tracked sheet SH (conditions.cpp): Reason::pinch_lost when
+  // its grasp point is off the pinch's way (bend, lay), Reason::fold_lost when, the pinch let go,
+  // it is off where the layer was laid (swipe, harden); Reason::none when on it, outside those
+  // states, or not judged (JUDGED false: a model state from within the state's first 150 ms,
+  // which may lag the state's motion; the time off the way runs on through it).
+  [[nodiscard]] Reason grasp_off(const SheetState& sh, bool& judged) const noexcept;
   [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2]) const noexcept;
   // actions.cpp: entry and exit actions, the goals.
   void enter(S s, const Sensing& in, Outbox& out) noexcept;

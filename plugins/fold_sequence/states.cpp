@@ -170,6 +170,7 @@ constexpr const char* kReasonNames[] = {
     "device_fault", "vision_lost",    "force_limit",        "unreachable",
     "goal_refused", "motion_aborted", "slide_out_of_range", "no_sheet",
     "command_lost", "operator_abort", "no_contact",         "pinch_lost",
+    "fold_lost",
 };
 static_assert(sizeof(kReasonNames) / sizeof(kReasonNames[0]) == static_cast<std::size_t>(Reason::count));
 

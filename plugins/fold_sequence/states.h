@@ -89,6 +89,7 @@ enum class Reason : std::uint8_t {
   operator_abort,
   no_contact,  // a contact descent reached its depth (below the surface) without a contact
   pinch_lost,  // the tracked grasp point left the pinching tool's way (bend, lay)
+  fold_lost,   // ... or, the pinch let go, left where the layer was laid (swipe, harden)
   count
 };
 [[nodiscard]] const char* reason_name(Reason r) noexcept;

@@ -354,6 +354,24 @@ TEST_CASE(
         doctest::Approx(std::hypot(25.0, 20.0)).epsilon(1e-3));
 }
 
+TEST_CASE("a laid layer that springs back once the pinch let go aborts the swipe as fold_lost") {
+  // A trial (seed 15): the pinch opened, the layer sprang back over the fixing hand's press and the
+  // sequence swiped and hardened a sheet lying unfolded, to `done`.
+  Rig held;
+  held.move_cycles = 600;  // motions of 0.6 s: the check judges a model state 150 ms into a state
+  start_and_run_to(held, "fold/swipe/approach");
+  REQUIRE(held.run_to("done", 400000));  // the layer stays where it was laid: nothing lost
+  Rig r;
+  r.move_cycles = 600;
+  start_and_run_to(r, "fold/swipe/approach");
+  r.spring_back();
+  REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }));
+  CHECK(std::string(r.status().why).find("tracked grasp point off the laid layer") !=
+        std::string::npos);
+  REQUIRE(r.run_to("aborted", 100000));
+  CHECK(r.status().abort_reason == static_cast<std::uint8_t>(crease::fold::Reason::fold_lost));
+}
+
 TEST_CASE("the diagonal fold runs from its file alone: its crease, its via points") {
   Rig r(fold_file("diagonal.yaml"), false);
   r.command(Command::start);

@@ -113,7 +113,15 @@ class Rig {
         p[1] = static_cast<float>(y0 - sign * 148.5 * j);
         p[2] = 0;
         s.normal[j * 3 + i][2] = -1;
+        for (int c = 0; c < 3; ++c) flat_[j * 3 + i][c] = p[c];
       }
+  }
+  // The laid layer springs back: the node the pinch carried returns to where it lay flat (the
+  // tracked sheet unfolded).
+  void spring_back() {
+    REQUIRE(carried_ >= 0);
+    for (int c = 0; c < 3; ++c) sheet_->position_mm[carried_][c] = flat_[carried_][c];
+    carried_new_ = true;
   }
 
   // One control cycle.
@@ -411,6 +419,7 @@ class Rig {
   std::unique_ptr<FoldSequencePlugin> plugin_;
   std::unique_ptr<SheetState> sheet_;
   int carried_ = -1;  // the node the pinch carries (carry()); -1: none yet
+  std::array<std::array<float, 3>, 9> flat_{};  // where place_sheet laid each node
   bool carried_new_ = false;
   LatestOutput<ArmMotionStatus> arm_out_[2];
   LatestOutput<HandControlStatus> hand_out_[2];
