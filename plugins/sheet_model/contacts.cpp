@@ -85,6 +85,7 @@ void ContactSolver::configure(const Topology& topo, const GridParams& grid, cons
   thickness_ = grid.thickness_mm;
   half_thickness_ = 0.5 * grid.thickness_mm;
   friction_ = solver.friction;
+  layer_friction_ = solver.layer_friction;
   self_enabled_ = solver.self_collision;
   const int n = topo.grid.count();
   shape_pairs_.resize(static_cast<std::size_t>(n) * kMaxContactsPerNode);
@@ -358,11 +359,28 @@ void ContactSolver::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std:
                         bary[2] * bary[2] * w[ic];
     if (wsum <= 0) continue;
     const Vec3 dir = c.side * nrm;
-    const double s = (thickness_ - d) / wsum;
+    const double depth = thickness_ - d;
+    const double s = depth / wsum;
     x[c.node] += (s * w[c.node]) * dir;
     x[ia] -= (s * bary[0] * w[ia]) * dir;
     x[ib] -= (s * bary[1] * w[ib]) * dir;
     x[ic] -= (s * bary[2] * w[ic]) * dir;
+    if (layer_friction_ <= 0) continue;
+    // Coulomb friction between the layers: the node's slip over the triangle's point under it
+    // this substep, tangential part, cancelled whole while under layer_friction x depth
+    // (sticking), else by that much (sliding); shared by the inverse masses like the push.
+    const Vec3 slip =
+        (x[c.node] - prev[c.node]) - (bary[0] * (x[ia] - prev[ia]) + bary[1] * (x[ib] - prev[ib]) +
+                                      bary[2] * (x[ic] - prev[ic]));
+    const Vec3 t = slip - dot(slip, dir) * dir;
+    const double tl = std::sqrt(dot(t, t));
+    if (!(tl > 0)) continue;
+    const double bound = layer_friction_ * depth;
+    const Vec3 corr = (tl <= bound ? 1.0 : bound / tl) / wsum * t;
+    x[c.node] -= w[c.node] * corr;
+    x[ia] += (bary[0] * w[ia]) * corr;
+    x[ib] += (bary[1] * w[ib]) * corr;
+    x[ic] += (bary[2] * w[ic]) * corr;
   }
 }
 

@@ -74,7 +74,7 @@ class ContactSolver {
   void detect_self_rt(std::span<const Vec3> x, double margin_mm, double lateral_mm) noexcept;
 
   const Topology* topo_ = nullptr;
-  double half_thickness_ = 0.5, thickness_ = 1.0, friction_ = 0.5;
+  double half_thickness_ = 0.5, thickness_ = 1.0, friction_ = 0.5, layer_friction_ = 0.0;
   bool self_enabled_ = true;
   bool has_simd_ = false, use_simd_ = false;  // AVX2 node screening (runtime check)
   bool has_select_simd_ = false, use_select_simd_ = false;  // AVX-512 select (layer_select.h)

@@ -104,8 +104,13 @@ struct SolverParams {
   // normal alone, a flap that turns ahead of the model is pushed out along its tangent each frame
   // (its hinge rises off the crease); along the bisector the pull follows the chord of the turn.
   bool depth_surface_normal = true;
-  // Contacts: Coulomb friction coefficient against rigid shapes and between layers.
+  // Contacts: Coulomb friction coefficient against rigid shapes.
   double friction = 0.5;
+  // ... and between layers (paper on paper; position-based: a node's slip over the triangle
+  // under it in a substep is cancelled up to this times the depth the layer contact corrected).
+  // 0: frictionless layers (the tracking model's default; the world's sheet takes its drawn
+  // paper-paper figure).
+  double layer_friction = 0.0;
   bool self_collision = true;
   // Layer contacts are enforced every this many substeps and always on the last one (a node
   // keeps its side for the whole frame, so one skipped substep cannot lose it).

@@ -44,6 +44,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : params
   sp.solver.compliance_bending_m_per_n /= draws_.stiffness_scale;
   sp.solver.yield_strain *= draws_.yield_scale;
   sp.solver.friction = params_.table_friction ? draws_.paper_table : 0.0;  // the sheet's own table contact
+  sp.solver.layer_friction = params_.layer_friction ? draws_.paper_paper : 0.0;
   sp.grid.origin_mm.z = params_.table_height_mm + 0.5 * sp.grid.thickness_mm;
   sheet_ = std::make_unique<sheet::XpbdSheet>(sp);
   {

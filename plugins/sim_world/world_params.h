@@ -71,6 +71,7 @@ struct WorldParams {
   bool thumb_contacts = true;    // the thumb's covers press the other fingers' (thumb_contacts.h)
   bool finger_friction = true;   // Coulomb friction between the hands and the sheet
   bool table_friction = true;    // Coulomb friction between the sheet and the table
+  bool layer_friction = true;    // ... and between its layers (paper on paper)
   bool joint_compliance = true;  // the hand joints are springs (else rigid at their targets)
 };
 

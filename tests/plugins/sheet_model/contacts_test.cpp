@@ -146,3 +146,66 @@ TEST_CASE("without the skin beside the triangles, sliding nodes lose their candi
   CHECK(ref_total > 0);
   CHECK(kept_total < ref_total);
 }
+
+namespace {
+
+// The half fold flat (the far half on top of the near one), the top layer pressed 0.3 mm into
+// the bottom one while the bottom layer moves 1 mm along x in a substep (a hand drags the stack).
+// Returns how far the top layer's nodes moved along x on average (mm) after one solve_rt with
+// layer friction MU.
+double top_layer_drag_mm(double mu) {
+  GridParams gp;
+  const Topology topo = build_topology(gp, TopologyParams{});
+  SolverParams sp;
+  sp.layer_friction = mu;
+  const FoldScript script = FoldScript::half_fold(gp);
+  std::vector<Vec3> x(topo.grid.count());
+  script.node_positions(0.0, x);  // flat
+  // The far rows laid mirrored onto the near ones, 0.7 x the thickness over them (0.3 of it deep).
+  const int w_nodes = topo.grid.w, h_nodes = topo.grid.count() / topo.grid.w;
+  const double z0 = x[0].z;
+  for (int j = (h_nodes + 1) / 2; j < h_nodes; ++j)
+    for (int i = 0; i < w_nodes; ++i) {
+      Vec3& p = x[static_cast<std::size_t>(j * w_nodes + i)];
+      p = x[static_cast<std::size_t>((h_nodes - 1 - j) * w_nodes + i)];
+      p.z = z0 + 0.7 * gp.thickness_mm;
+    }
+  const double mid_z = z0 + 0.35 * gp.thickness_mm;
+  ContactSolver solver;
+  solver.configure(topo, gp, sp);
+  solver.detect_rt(x, nullptr, 2.0);
+  REQUIRE(solver.stats().self_pairs > 0);
+  std::vector<Vec3> prev = x;
+  std::vector<double> w(x.size(), 1.0);
+  std::vector<bool> top(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    top[i] = x[i].z > mid_z;
+    if (!top[i]) x[i].x += 1.0;
+  }
+  const std::vector<Vec3> before = x;
+  solver.solve_rt(x, prev, w);
+  double moved = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (top[i]) {
+      moved += x[i].x - before[i].x;
+      ++n;
+    }
+  return moved / n;
+}
+
+}  // namespace
+
+// Paper on paper (the world's sheet: its drawn paper-paper coefficient): a layer pressed onto
+// another is carried along by it, by at most the coefficient times the depth each contact
+// corrected; frictionless layers slide freely (the failing variant, the tracking model's default).
+TEST_CASE(
+    "layer friction: a layer pressed onto a moving one is dragged along; without friction it is "
+    "not") {
+  const double dragged = top_layer_drag_mm(0.4);
+  MESSAGE("top layer dragged " << dragged << " mm by the bottom layer's 1 mm (friction 0.4)");
+  CHECK(dragged > 0.01);
+  CHECK(dragged < 0.4 * 0.3 + 1e-9);  // at most mu x depth: kinetic, a 1 mm slip beats 0.12 mm
+  // Frictionless: only the pushes of the slanted cells by the crease move it along x, ~2 % of that.
+  CHECK(std::fabs(top_layer_drag_mm(0.0)) < 0.05 * dragged);
+}
