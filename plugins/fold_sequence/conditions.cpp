@@ -329,9 +329,9 @@ Reason Machine::grasp_off(const SheetState& sh, bool& judged) const noexcept {
   const bool laid = (is_within(m_.leaf, S::swipe) && m_.leaf != S::swipe_release) ||
                     is_within(m_.leaf, S::harden);
   judged = true;
-  if (spec_.pinch_lost_mm <= 0 || (m_.leaf != S::follow_via && !lay && !laid) ||
-      spec_.via_count == 0)
-    return Reason::none;
+  const bool checked =
+      (m_.leaf == S::follow_via || lay) ? spec_.pinch_lost_mm > 0 : laid && spec_.fold_lost_mm > 0;
+  if (!checked || spec_.via_count == 0) return Reason::none;
   if (sh.timestamp_ns < m_.leaf_since_ns + kModelLagNs) {
     judged = false;
     return Reason::none;
@@ -344,7 +344,7 @@ Reason Machine::grasp_off(const SheetState& sh, bool& judged) const noexcept {
     const double on_stack[3] = {spec_.lay_mm[0], spec_.lay_mm[1], 0.0};
     sheet_to_world(m_.frame_held != 0 ? m_.held_frame : live, on_stack, at);
     const double d = std::hypot(g[0] - at[0], g[1] - at[1], g[2] - at[2]);
-    return d > spec_.pinch_lost_mm ? Reason::fold_lost : Reason::none;
+    return d > spec_.fold_lost_mm ? Reason::fold_lost : Reason::none;
   }
   const int k =
       lay ? spec_.via_count : std::min<int>(m_.via, spec_.via_count - 1);  // the point it goes to

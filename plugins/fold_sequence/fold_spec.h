@@ -54,6 +54,9 @@ struct FoldSpec {
   // (Machine::pinch_lost). 0: not checked.
   double pinch_lost_mm = 0;
   double pinch_lost_s = 0;  // ... on every observed model state for this long (0: the first)
+  // The laid layer lost (swipe, harden: the pinch let go): the grasp point further than this (mm)
+  // from where the layer was laid, for pinch_lost_s. 0: not checked.
+  double fold_lost_mm = 0;
   double vision_lost_max_s = 0.5;   // sheet_state stale, or fewer than min_observations, this long: abort
   std::uint32_t min_observations = 1;
   double sheet_max_age_s = 0.2;     // a sheet_state older than this is not the current sheet

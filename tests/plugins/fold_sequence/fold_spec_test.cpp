@@ -73,6 +73,7 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.has_release_stiffness);
   CHECK(h.pinch_lost_mm == 50.0);
   CHECK(h.pinch_lost_s == 0.3);
+  CHECK(h.fold_lost_mm == 100.0);
   CHECK(h.release_stiffness[15] == doctest::Approx(0.5));  // the thumb soft while it opens
   CHECK(h.release_stiffness[3] == doctest::Approx(2.0));
   REQUIRE(h.grasp_above_via_count == 1);
@@ -95,6 +96,7 @@ TEST_CASE("the shipped folds load") {
   CHECK_FALSE(d.has_release_stiffness);  // absent: the controller's stiffness kept
   CHECK(d.pinch_lost_mm == 0.0);         // absent: not checked
   CHECK(d.pinch_lost_s == 0.0);
+  CHECK(d.fold_lost_mm == 0.0);
   CHECK(d.fold_line_mm[1][0] == 210.0);
   CHECK(d.via_count == 5);
 }
