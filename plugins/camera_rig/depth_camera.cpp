@@ -20,6 +20,7 @@ DepthCamera load_depth_camera(const std::string& path) {
   d.depth_unit_mm = static_cast<double>(n);
   if (!(d.depth_unit_mm > 0.0 && d.depth_unit_mm <= 10.0))
     throw crease::ConfigError(path + ": key 'depth_unit_mm': must be in (0, 10]");
+  d.mount = load_camera_mount(path);
   return d;
 }
 
@@ -28,6 +29,8 @@ void save_depth_camera(const DepthCamera& cam, const std::string& path) {
   cv::FileStorage fs(path, cv::FileStorage::APPEND);
   if (!fs.isOpened()) throw crease::Error(path + ": cannot open for writing");
   fs << "depth_unit_mm" << cam.depth_unit_mm;
+  fs.release();
+  if (cam.mount) save_camera_mount(*cam.mount, path);
 }
 
 std::vector<DepthCamera> load_depth_camera_dir(const std::string& dir) {

@@ -2,9 +2,13 @@
 // per calibrated depth camera, the 16-bit depth and the registered BGR colour image of the sheet
 // mesh the scene holds for that frame (depth_view.h: the D4xx noise model), in the channel order
 // of plugins/camera_rig/depth_camera.h. The `camera_depth_sim` plugin feeds it the `sheet_truth`
-// port. Not RT code: it runs on a camera worker thread.
+// port. A camera the robot carries (DepthCamera::mount: a wrist camera) is rendered each frame from
+// where the world's shapes of that frame put its mount shape (carried_camera.h); when they hold no
+// such shape (none received yet) its images are left empty (nothing delivered) and counted.
+// Not RT code: it runs on a camera worker thread.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -43,12 +47,25 @@ class DepthSimSource final : public CameraSource {
     shapes_now_ = std::move(shapes_now);
   }
 
+  // Any thread: frames of carried cameras rendered or skipped (one per camera per frame), and of
+  // those the ones skipped for want of their mount shape.
+  [[nodiscard]] std::uint64_t carried_frames() const noexcept {
+    return carried_frames_.load(std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::uint64_t carried_unposed() const noexcept {
+    return carried_unposed_.load(std::memory_order_relaxed);
+  }
+  [[nodiscard]] bool any_carried() const noexcept { return any_carried_; }
+
   // A plain sheet's texture (uniform white) for the constructor's front and back.
   [[nodiscard]] static cv::Mat plain_texture(double w_mm, double h_mm, double px_per_mm);
 
  private:
   std::vector<DepthCamera> depth_cams_;
-  std::vector<Camera> cams_;
+  std::vector<Camera> cams_;   // as calibrated (a carried camera's pose relative to its mount)
+  std::vector<Camera> posed_;  // where each camera is this frame (worker thread)
+  bool any_carried_ = false;
+  std::atomic<std::uint64_t> carried_frames_{0}, carried_unposed_{0};
   std::vector<cv::Mat> rays_;
   ViewRenderer renderer_;
   std::function<SheetMesh(std::uint64_t)> mesh_at_;

@@ -255,6 +255,8 @@ void shapes_of(const crease::WorldShapes& in, std::vector<SceneShape>& out) {
     o.geom.half_mm = {s.half_mm[0], s.half_mm[1], s.half_mm[2]};
     o.pose.t = {s.position_mm[0], s.position_mm[1], s.position_mm[2]};
     for (int k = 0; k < 9; ++k) o.pose.r[k] = s.rotation[k];
+    o.role = s.role;
+    o.side = s.side;
   }
 }
 

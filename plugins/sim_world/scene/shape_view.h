@@ -8,10 +8,10 @@
 // plugins/sim_world/shape_geometry.h (box edges rounded). Not RT code (a camera worker's).
 #pragma once
 
+#include <cstdint>
+#include <opencv2/core.hpp>
 #include <span>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/port_types/world_shapes.h"
 #include "plugins/camera_rig/camera_model.h"
@@ -22,6 +22,8 @@ namespace crease::vision {
 struct SceneShape {
   world::Geom geom;  // mm
   world::Pose pose;  // world mm
+  crease::WorldShapes::Role role = crease::WorldShapes::Role::arm;  // what it is of (the port's)
+  std::uint8_t side = 0;                                            // 0 right, 1 left
 };
 
 // The shapes of a `world_shapes` payload (its first `count`, at most kCapacity). OUT keeps its

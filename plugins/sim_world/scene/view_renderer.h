@@ -44,6 +44,13 @@ class ViewRenderer {
                std::vector<Camera> cameras);
 
   [[nodiscard]] const std::vector<Camera>& cameras() const { return cameras_; }
+  // Moves camera `cam` to the world -> camera pose (R, t) for the renders that follow (a camera
+  // the robot carries); its intrinsics and rays stay. No allocation; not while rendering.
+  void set_pose(int cam, const cv::Matx33d& R, const cv::Vec3d& t) {
+    Camera& c = cameras_.at(static_cast<std::size_t>(cam));
+    c.R = R;
+    c.t = t;
+  }
   // Renders camera `cam` seeing `mesh` and the world's `shapes` (the arms and hands: skin-coloured
   // occluders of their real geometry, depth-tested against the sheet); the seed is mixed with
   // the camera index.
