@@ -5,7 +5,9 @@
 // springs. The update only hands the model state over and copies the newest result out.
 //   in:  depth_images (frames), sheet_state (latest, SheetState)
 //   out: depth_targets (latest, DepthTargets)
-// Parameters: cameras: DIR (the depth calibrations, with depth_unit_mm) and depth_tracker.h's.
+// Parameters: cameras: DIR (the depth calibrations, with depth_unit_mm; a camera the robot
+// carries, camera_mount.h, is a configuration error: its pose changes every frame) and
+// depth_tracker.h's.
 // Status: degraded when the newest result has no target (no model state yet, no cloud: an
 // empty mask, no valid depth, a camera dark) or a camera delivered nothing; fault when the
 // worker failed.
@@ -26,6 +28,10 @@ class DepthTrackingPlugin final : public Plugin {
  public:
   void configure(const Params& p, PortBinder& ports) override {
     const auto cams = vision::load_depth_camera_dir(p.get_path("cameras", "depth_cameras"));
+    for (const auto& c : cams)  // its points are put in the world with each camera's fixed pose
+      if (c.mount)
+        p.fail("cameras", c.camera.name + " is carried (" + vision::describe(*c.mount) +
+                              "): the depth path takes cameras fixed in the world only");
     const depth::TrackerParams tp = depth::tracker_params_from(p);
     all_cameras_ = cams.size() >= 32 ? 0xffffffffu : (1u << cams.size()) - 1u;
     auto channel = vision::bind_depth_images(ports, vision::cameras_of(cams), vision::ImagesEnd::reader);

@@ -1,15 +1,25 @@
 // camera_depth_sim in a loop with `world_shapes: true`: the world's shapes of that port are taken
 // every cycle and rendered by the worker (their depth: tests/plugins/sim_world/scene/
 // depth_view_test.cpp); frame sets keep coming from both cameras and the update allocates nothing.
+// The D405-like wrist cameras (config/wrist_cameras, carried on the forearms): no set holds them
+// until the world's shapes come (each camera frame counted on `carried_unposed`), then both
+// deliver; the configuration errors of a carried camera (tests/plugins/sim_world/scene/
+// carried_camera_test.cpp: the images from the moved pose).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 
+#include "core/errors.h"
 #include "core/plugin_host.h"
 #include "core/port_types/camera_frames.h"
+#include "core/port_types/figure.h"
 #include "core/port_types/world_shapes.h"
+#include "plugins/camera_rig/depth_camera.h"
 #include "support/host_poll.h"
 #include "support/instance_spec.h"
 
@@ -55,4 +65,129 @@ TEST_CASE(
     CHECK(i.stats->rt_allocations.load() == 0);
   }
   host.stop();
+}
+
+namespace {
+
+// The right (side 0) or left forearm's cylinder and capsule (role hand, config/robot/
+// crease_robot.urdf) placed so that the wrist camera mounted on the capsule looks straight down
+// from c_w (world mm): shapes[first], shapes[first + 1].
+void forearm_carrying(const crease::vision::Camera& cam, int side, const cv::Vec3d& c_w,
+                      crease::WorldShapes& out, std::uint32_t first) {
+  const cv::Matx33d R_wc(1, 0, 0, 0, -1, 0, 0, 0, -1);
+  const cv::Matx33d R_s = R_wc.t() * cam.R;
+  const cv::Vec3d p_s = c_w + R_s * (cam.R.t() * cam.t);
+  const cv::Vec3d centres[2] = {p_s + R_s * cv::Vec3d(0, 5, -105), p_s};
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    crease::WorldShapes::Shape& s = out.shapes[first + k];
+    s.kind = k == 0 ? crease::WorldShapes::Kind::cylinder : crease::WorldShapes::Kind::capsule;
+    s.role = crease::WorldShapes::Role::hand;
+    s.side = static_cast<std::uint8_t>(side);
+    s.radius_mm = k == 0 ? 67.5f : 45.f;
+    s.half_length_mm = k == 0 ? 5.f : 55.f;
+    for (int i = 0; i < 3; ++i) s.position_mm[i] = static_cast<float>(centres[k][i]);
+    for (int i = 0; i < 9; ++i) s.rotation[i] = static_cast<float>(R_s.val[i]);
+  }
+  out.count = std::max(out.count, first + 2);
+}
+
+std::string configure_error(const std::string& yaml) {
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"vision", 30.0, 0, -1});
+  try {
+    host.add_instance(
+        crease::testing::instance_spec("wrist", "camera_depth_sim", "vision", 5, yaml));
+  } catch (const crease::ConfigError& e) {
+    return e.what();
+  }
+  return "configured";
+}
+
+}  // namespace
+
+TEST_CASE(
+    "camera_depth_sim wrist cameras: invalid and counted until the world's shapes come, then from "
+    "the hands; no allocation in its update") {
+  crease::PluginHost host({CREASE_PLUGIN_DIR});
+  host.add_loop({"vision", 30.0, 0, -1});
+  host.add_instance(
+      crease::testing::instance_spec("truth", "sheet_truth", "vision", 1, "{start_s: 1000}"));
+  host.add_instance(crease::testing::instance_spec(
+      "wrist", "camera_depth_sim", "vision", 5,
+      "{cameras: wrist_cameras, sheet: plain, world_shapes: true, sensor: d405}"));
+  crease::rt::LatestChannel* shapes_w = host.ports().bind_latest_writer(
+      "world_shapes", crease::port_type_of<crease::WorldShapes>(), "test");
+  REQUIRE(shapes_w != nullptr);
+  host.start();
+  crease::CameraFrames f{};
+  crease::Figure unposed{};
+  const auto read = [&] {
+    host.ports().find_latest("depth_frames")->read(&f, 0);
+    host.ports().find_latest("carried_unposed")->read(&unposed, 0);
+  };
+  // No world_shapes yet: the sets come, neither camera in them, every camera frame counted.
+  REQUIRE(crease::testing::poll_until(
+      host,
+      [&] {
+        read();
+        return f.sequence >= 3 && unposed.count >= 6;
+      },
+      std::chrono::seconds(60), std::chrono::milliseconds(20)));
+  CHECK(f.valid_mask == 0);
+  CHECK(unposed.mean() == doctest::Approx(100.0));
+  CHECK(unposed.last == 100.0);
+  for (const auto& i : host.instances()) CHECK(i.state == crease::RunState::active);
+  // The forearms come: both wrist cameras look down at the sheet from 300 mm.
+  const auto cams = crease::vision::load_depth_camera_dir(std::string(CREASE_SOURCE_DIR) +
+                                                          "/config/wrist_cameras");
+  auto shapes = std::make_unique<crease::WorldShapes>();
+  forearm_carrying(cams[0].camera, 0, {60, 0, 300}, *shapes, 0);
+  forearm_carrying(cams[1].camera, 1, {-60, 0, 300}, *shapes, 2);
+  std::int64_t stamp = 1;
+  REQUIRE(crease::testing::poll_until(
+      host,
+      [&] {
+        shapes_w->write(shapes.get(), stamp++);
+        read();
+        return f.valid_mask == 0xf;
+      },
+      std::chrono::seconds(60), std::chrono::milliseconds(20)));
+  CHECK(unposed.last == 0.0);
+  CHECK(unposed.mean() < 100.0);
+  for (const auto& i : host.instances()) {
+    CAPTURE(i.name);
+    CHECK(i.state == crease::RunState::active);
+    CHECK(i.stats->updates.load() > 0);
+    CHECK(i.stats->rt_allocations.load() == 0);
+  }
+  host.stop();
+}
+
+TEST_CASE("camera_depth_sim wrist cameras: configuration errors name the file and the key") {
+  const std::string file = "config/test.yaml:1:";
+  std::string what = configure_error("{cameras: wrist_cameras}");
+  CAPTURE(what);
+  CHECK(what.find(file) != std::string::npos);
+  CHECK(what.find("wrist.params.world_shapes: must be true: cam0 is carried (right hand #1)") !=
+        std::string::npos);
+  what = configure_error(
+      "{cameras: wrist_cameras, world_shapes: true, record: /tmp/crease_wrist_rec}");
+  CHECK(what.find("wrist.params.record: cam0 is carried (right hand #1): its pose per frame has no "
+                  "replay layout") != std::string::npos);
+  what = configure_error("{cameras: wrist_cameras, world_shapes: true, sensor: d415}");
+  CHECK(what.find("wrist.params.sensor: must be d435 or d405, not 'd415'") != std::string::npos);
+  // A wrist camera naming a side that does not exist: its file and key.
+  const auto dir = std::filesystem::temp_directory_path() / "crease_wrist_bad_side";
+  std::filesystem::create_directories(dir);
+  {
+    std::ifstream in(std::string(CREASE_SOURCE_DIR) + "/config/wrist_cameras/cam0.yaml");
+    std::ofstream out(dir / "cam0.yaml");
+    std::string line;
+    while (std::getline(in, line))
+      out << (line == "mount_side: right" ? "mount_side: middle" : line) << "\n";
+  }
+  what = configure_error("{cameras: " + dir.string() + ", world_shapes: true}");
+  CHECK(what.find((dir / "cam0.yaml").string() +
+                  ": key 'mount_side': 'middle' is no side: right | left") != std::string::npos);
+  std::filesystem::remove_all(dir);
 }

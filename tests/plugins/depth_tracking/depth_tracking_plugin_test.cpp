@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/errors.h"
 #include "core/plugin_host.h"
 #include "core/port_types/depth_targets.h"
 #include "core/port_types/sheet_state.h"
@@ -158,4 +159,17 @@ TEST_CASE("depth only, plain sheet: the model tracks the half fold; without the 
   CHECK(off.mean_mm > 3 * kMeanBoundMm);  // the physics alone does not fold the sheet
   CHECK(off.end_mm > 3 * kEndBoundMm);
   CHECK(on.allocation_free);
+}
+
+TEST_CASE("depth_tracking refuses a camera the robot carries, naming the key and the camera") {
+  Host h;
+  h.host.add_loop({"vision", 30.0, 0, -1});
+  try {
+    h.add("depth", "depth_tracking", "vision", 10, "{cameras: wrist_cameras}");
+    FAIL("configured");
+  } catch (const crease::ConfigError& e) {
+    const std::string what = e.what();
+    CAPTURE(what);
+    CHECK(what.find("depth.params.cameras: cam0 is carried (right hand #1)") != std::string::npos);
+  }
 }
