@@ -23,6 +23,20 @@
 #include "support/host_poll.h"
 #include "support/instance_spec.h"
 
+namespace {
+
+// Every instance of HOST active, updated, and never allocating in its update.
+void check_running_without_allocation(const crease::PluginHost& host) {
+  for (const auto& i : host.instances()) {
+    CAPTURE(i.name);
+    CHECK(i.state == crease::RunState::active);
+    CHECK(i.stats->updates.load() > 0);
+    CHECK(i.stats->rt_allocations.load() == 0);
+  }
+}
+
+}  // namespace
+
 TEST_CASE(
     "camera_depth_sim with world_shapes: frame sets from both cameras, no allocation in its "
     "update") {
@@ -58,12 +72,7 @@ TEST_CASE(
   REQUIRE(crease::testing::poll_until(host, moved, std::chrono::seconds(60),
                                       std::chrono::milliseconds(20)));
   CHECK(f.valid_mask == 0xf);  // each camera's depth and colour images
-  for (const auto& i : host.instances()) {
-    CAPTURE(i.name);
-    CHECK(i.state == crease::RunState::active);
-    CHECK(i.stats->updates.load() > 0);
-    CHECK(i.stats->rt_allocations.load() == 0);
-  }
+  check_running_without_allocation(host);
   host.stop();
 }
 
@@ -154,12 +163,7 @@ TEST_CASE(
       std::chrono::seconds(60), std::chrono::milliseconds(20)));
   CHECK(unposed.last == 0.0);
   CHECK(unposed.mean() < 100.0);
-  for (const auto& i : host.instances()) {
-    CAPTURE(i.name);
-    CHECK(i.state == crease::RunState::active);
-    CHECK(i.stats->updates.load() > 0);
-    CHECK(i.stats->rt_allocations.load() == 0);
-  }
+  check_running_without_allocation(host);
   host.stop();
 }
 
