@@ -32,6 +32,9 @@ class CanopenDevice {
   void set_silent(bool s) noexcept { silent_.store(s); }
   [[nodiscard]] const SimDeviceCounters& counters() const noexcept { return counters_; }
 
+  // The command watchdog's bound (ns of the device's clock).
+  [[nodiscard]] std::int64_t watchdog_ns() const noexcept { return watchdog_ns_; }
+
  protected:
   CanopenDevice(CanBus& bus, std::uint8_t node, std::int64_t watchdog_ns, std::int64_t heartbeat_period_ns,
                 bool auto_start) noexcept

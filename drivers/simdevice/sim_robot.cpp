@@ -16,9 +16,11 @@ SimRobot::SimRobot(const SimRobotConfig& cfg) {
     h.node = nodes[s];
     h.pressure_sensors = s == 1;  // the left hand's air-pressure sensors
     h.external_positions = cfg.hand_external_positions;
+    h.watchdog_ns = cfg.watchdog_ns;
     hands_[s] = std::make_unique<SimHand>(*buses_[s], h);
     SimArmConfig a;
     a.node = nodes[2 + s];
+    a.watchdog_ns = cfg.watchdog_ns;
     for (int j = 0; j < arm::kJoints; ++j) a.initial_position_rad[j] = cfg.arm_initial_rad[s][j];
     arms_[s] = std::make_unique<SimArm>(*buses_[2 + s], a);
   }

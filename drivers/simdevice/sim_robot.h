@@ -23,6 +23,9 @@ struct SimRobotConfig {
   std::uint32_t bitrate = 1'000'000;       // arbitration phase, bit/s
   std::uint32_t data_bitrate = 5'000'000;  // FD data phase, bit/s
   bool hand_external_positions = false;    // SimHandConfig::external_positions of both hands
+  // Every device's command watchdog (ns of its clock without a valid command: safe state or quick
+  // stop; SimHandConfig / SimArmConfig::watchdog_ns).
+  std::int64_t watchdog_ns = 20'000'000;
   // The arms' joint angles at power-up (rad): right, left.
   std::array<std::array<float, arm::kJoints>, 2> arm_initial_rad{};
 };

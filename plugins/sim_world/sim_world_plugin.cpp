@@ -15,6 +15,7 @@
 // The devices answer on `<bus_prefix>-hand_r`, `-hand_l`, `-arm_r`, `-arm_l` as sim_devices'
 // do (this plugin takes its place; the drivers' parameters are the same). Parameters:
 // world_config.h and README.md.
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -57,6 +58,7 @@ class SimWorldPlugin final : public Plugin {
     rc.prefix = cfg_.bus_prefix;
     rc.bitrate = cfg_.bitrate;
     rc.data_bitrate = cfg_.data_bitrate;
+    rc.watchdog_ns = std::llround(cfg_.device_watchdog_ms * 1e6);
     try {
       devices_ = std::make_unique<wd::WorldDevices>(*world_, rc);
     } catch (const std::exception& e) {

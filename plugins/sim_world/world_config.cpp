@@ -99,6 +99,7 @@ WorldPluginConfig read_world_config(const Params& p) {
   c.bus_prefix = *drivers::bus_prefix_from_params(p, std::string(drivers::kAutoBusPrefix));
   c.bitrate = static_cast<std::uint32_t>(p.get_in_range<int>("bitrate", 1'000'000, 10'000, 1'000'000));
   c.data_bitrate = static_cast<std::uint32_t>(p.get_in_range<int>("data_bitrate", 5'000'000, 10'000, 8'000'000));
+  c.device_watchdog_ms = p.get_in_range<double>("device_watchdog_ms", 20.0, 1.0, 1000.0);
   c.tactile_link = p.get<std::string>("tactile_link", c.tactile_link);
   if (c.tactile_link == "none") {
     c.tactile_link.clear();

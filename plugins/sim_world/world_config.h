@@ -25,6 +25,10 @@ struct WorldPluginConfig {
   int shapes_every_steps = 16;
   std::string bus_prefix;  // resolved (`auto`: this creased's own, drivers/host/bus_prefix.h)
   std::uint32_t bitrate = 1'000'000, data_bitrate = 5'000'000;
+  // `device_watchdog_ms`: the simulated devices' command watchdog (their clock, the world's: a
+  // control loop that stalls this long while the world steps on quick-stops the arms and makes
+  // the hands safe, as a real device does after 20 ms, the default).
+  double device_watchdog_ms = 20.0;
   // `tactile_link`: the taxel matrix's serial link, a Unix socket at simulated_link_path(bus_prefix,
   // this) (drivers/host/bus_prefix.h) for hand_driver's `tactile_device: tactile_r`; empty
   // (`none`): no link.

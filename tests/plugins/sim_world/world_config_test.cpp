@@ -4,11 +4,13 @@
 #include "plugins/sim_world/world_config.h"
 
 #include <doctest/doctest.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <string>
 
 #include "core/errors.h"
+#include "drivers/simdevice/sim_robot.h"
 
 using namespace crease;
 using crease::world::read_world_config;
@@ -60,6 +62,25 @@ TEST_CASE("sheet_turn_deg turns the world's sheet grid; out of range it names fi
   const std::string e = error_of("sheet_turn_deg: 181\n");
   CHECK(e.find("sim.yaml:2") != std::string::npos);
   CHECK(e.find("sheet_turn_deg") != std::string::npos);
+}
+
+// The devices' command watchdog: a real device's 20 ms unless the configuration says
+// (config/sim.yaml: 100, as the drivers' tolerance of the shared machine's stalls); the simulated
+// robot takes it.
+TEST_CASE(
+    "device_watchdog_ms: 20 by default, the devices take what is given; out of range names file, "
+    "line and key") {
+  CHECK(read("").device_watchdog_ms == 20.0);
+  CHECK(read("device_watchdog_ms: 100\n").device_watchdog_ms == 100.0);
+  const std::string e = error_of("device_watchdog_ms: 0\n");
+  CHECK(e.find("sim.yaml:2") != std::string::npos);
+  CHECK(e.find("device_watchdog_ms") != std::string::npos);
+  crease::drivers::sim::SimRobotConfig rc;
+  rc.prefix = "crease-t-wd-" + std::to_string(::getpid());
+  rc.watchdog_ns = 100'000'000;
+  crease::drivers::sim::SimRobot robot(rc);
+  for (int i = 0; i < crease::drivers::sim::SimRobot::kDevices; ++i)
+    CHECK(robot.device(i).watchdog_ns() == 100'000'000);
 }
 
 TEST_CASE("faults: off unless asked; drawn from the world's seed unless fault_seed says; out of range names file, line and key") {
