@@ -120,8 +120,11 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(e.find("fold.shift.corner_mm: required") != std::string::npos);
   }
   SUBCASE("an unknown tool frame") {
-    const int line = line_of("  tool: ff_pad\n  fingers: [ff, mf, rf]");
-    const std::string e = error_of(variant("  tool: ff_pad\n  fingers: [ff, mf, rf]", "  tool: ff_bak\n  fingers: [ff, mf, rf]"));
+    const std::string swipe =
+        "  tool: ff_pad\n  fingers: [ff, mf]             # pitched";  // the swipe's
+    const int line = line_of(swipe);
+    const std::string e =
+        error_of(variant(swipe, "  tool: ff_bak\n  fingers: [ff, mf]             # pitched"));
     CHECK(e.find(tmp + ":" + std::to_string(line) + ":") == 0);
     CHECK(e.find("fold.swipe.tool: unknown tool frame 'ff_bak'") != std::string::npos);
   }
