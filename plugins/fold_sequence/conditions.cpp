@@ -300,10 +300,9 @@ Reason Machine::fault(const Sensing& in) noexcept {
   if (!seen) return Reason::none;  // a state without observations tells nothing either way
   bool judged = true;
   const Reason off = grasp_off(*sh, judged);
-  if (!judged) {  // a model state from before the state's lag: the time off the way runs on
-  } else if (off == Reason::none) {
+  if (judged && off == Reason::none) {  // unjudged (within the state's lag): the time runs on
     m_.pinch_off_since_ns = 0;
-  } else if (m_.pinch_off_since_ns == 0) {
+  } else if (judged && m_.pinch_off_since_ns == 0) {
     m_.pinch_off_since_ns = now;
   }
   if (m_.pinch_off_since_ns != 0 &&
@@ -341,6 +340,7 @@ Reason Machine::grasp_off(const SheetState& sh, bool& judged) const noexcept {
     double g[3], at[3];
     if (!sheet_frame(sh, live) || !node_at(sh, spec_.grasp_at_mm[0], spec_.grasp_at_mm[1], g))
       return Reason::none;
+    // Where the lay put the edge, in the lay's frame: the one held from the bend, else the tracked.
     const double on_stack[3] = {spec_.lay_mm[0], spec_.lay_mm[1], 0.0};
     sheet_to_world(m_.frame_held != 0 ? m_.held_frame : live, on_stack, at);
     const double d = std::hypot(g[0] - at[0], g[1] - at[1], g[2] - at[2]);

@@ -51,7 +51,7 @@ struct FoldSpec {
   // Sensing bounds.
   // The pinch lost (bend and lay): the tracked sheet's grasp point (the node nearest grasp.at_mm's
   // u, v) further than this (mm) from the pinching tool's way in the state and the one before
-  // (Machine::pinch_lost). 0: not checked.
+  // (Machine::grasp_off). 0: not checked.
   double pinch_lost_mm = 0;
   double pinch_lost_s = 0;  // ... on every observed model state for this long (0: the first)
   // The laid layer lost (swipe, harden: the pinch let go): the grasp point further than this (mm)
