@@ -95,6 +95,36 @@ TEST_CASE("C_force, right hand (taxels at 250 Hz): the figures") {
   }
 }
 
+// The taxel matrices resolve a force no finer than one taxel over its 8 kPa threshold (x 11 mm^2:
+// 0.09 N), so the right hand's shipped settle band is 0.1 N (config/sim.yaml, config/robot.yaml).
+// Within the default 0.02 N a 0.5 N press (the swipe's) is held as well but reported settled only
+// now and then: the sequence, waiting for a settled press with two fingers at once, timed out in
+// a trial after 20 s at 0.52-0.57 N measured.
+TEST_CASE(
+    "C_force, right hand: a 0.5 N press reads settled within the taxels' resolution (failing "
+    "variant: a 0.02 N band)") {
+  double share[2] = {};
+  for (int b = 0; b < 2; ++b) {
+    const double band = b == 0 ? 0.1 : 0.02;
+    CAPTURE(band);
+    HandWorld w(options("settle_band_n: " + std::to_string(band), robot::Side::right));
+    contact_then_press(w, 0.5);
+    const Hold h = hold(w, 0.5, 0.5);  // the press reaches its force
+    CHECK(h.within_ms >= 0);
+    long settled = 0;
+    constexpr long kCycles = 2000;
+    for (long i = 0; i < kCycles; ++i) {
+      w.cycle();
+      settled += w.status().settled == 1 ? 1 : 0;
+    }
+    share[b] = static_cast<double>(settled) / kCycles;
+    MESSAGE("band " << band << " N: settled in " << 100 * share[b]
+                    << " % of 2 s of holding 0.5 N; truth " << w.force_n() << " N");
+  }
+  CHECK(share[0] > 0.9);
+  CHECK(share[1] < 0.5 * share[0]);
+}
+
 // The arm's path falls 2 mm over the swipe (a sheet frame from vision off by 1.1 deg, a table
 // not level): with the targets held the force follows the path's height; C_force holds it.
 TEST_CASE("C_force during a 100 mm tangential swipe at 50 mm/s: within +-15 % (failing variant: the targets held)") {
