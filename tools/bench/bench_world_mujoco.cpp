@@ -144,6 +144,7 @@ bool run_mujoco(const Script& scene, const std::vector<MirroredShape>& shapes, d
     mj_step(m, d);
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (k == scene.mark_step) sheet_nodes(m, d, out.mark);
+    if (scene.mark2_step != 0 && k == scene.mark2_step) sheet_nodes(m, d, out.mark2);
   }
   out.wall_s = wall;
   out.simulated_s = static_cast<double>(steps) * scene.params.dt_s;
