@@ -1,7 +1,8 @@
 // Port payload `world_state`: the simulated world's truth beside its sheet (plugins/sim_world),
 // for scoring and views: per hand the fingertips' pad frames and contact forces, the palm's,
 // the joint angles the hand's compliant joints settled at; the sheet's contact area with the
-// table; the world's time and its counters of refused or repaired input.
+// table; how deep each arm reaches under the table; the world's time and its counters of refused
+// or repaired input.
 // World frame, mm, N, rad (names carry the units).
 #pragma once
 
@@ -33,7 +34,7 @@ struct WorldHand {
 
 struct WorldState {
   static constexpr char kPortType[] = "crease.WorldState";
-  static constexpr std::uint32_t kPortVersion = 1;
+  static constexpr std::uint32_t kPortVersion = 2;
   static constexpr int kSides = 2;  // right, left
 
   std::int64_t timestamp_ns = 0;  // CLOCK_MONOTONIC time of the step
@@ -41,6 +42,10 @@ struct WorldState {
   double time_s = 0;              // world time: step x dt
   WorldHand hand[kSides];
   float sheet_table_contact_area_mm2 = 0;
+  // Per side, how deep (mm) the arm's links and the wrist and forearm (kinematic, unlike the
+  // compliant hand) reach under the table's top over its extent this step: 0 where clear. The
+  // world moves them through the table; a real arm would hit it.
+  float under_table_mm[kSides] = {};
   // Counters since the start: joint targets clamped to the URDF limits, non-finite targets
   // refused, negative or non-finite stiffness refused, commands slowed to the joints' velocity
   // limits, steps rolled back after a non-finite result.
@@ -61,10 +66,12 @@ struct WorldState {
       for (int j = 0; j < WorldHand::kJoints; ++j)
         if (!std::isfinite(h.joint_rad[j])) return false;
     }
+    for (float v : under_table_mm)
+      if (!std::isfinite(v)) return false;
     return std::isfinite(sheet_table_contact_area_mm2) && std::isfinite(time_s);
   }
 };
 
-CREASE_PORT_PAYLOAD_LAYOUT(WorldState, 1120, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(WorldState, 1128, 8);
 
 }  // namespace crease

@@ -367,11 +367,16 @@ void World::fill_state_rt() noexcept {
       out.deflection_rad[j] = static_cast<float>(h.angles[j] - h.target[j]);
     }
     Vec3 tip_force[robot::kFingertips], tip_fric[robot::kFingertips], palm;
-    double tip_normal[robot::kFingertips] = {};
+    double tip_normal[robot::kFingertips] = {}, under_table = 0;
     bool tip_contact[robot::kFingertips] = {}, palm_contact = false;
     for (int k = 0; k < static_cast<int>(shapes_.size()); ++k) {
       const WorldShape& sh = shapes_[k];
       if (sh.side != s) continue;
+      if (sh.role == ShapeRole::arm || sh.role == ShapeRole::hand) {
+        const TableContact t = table_contact(sh.geom, sh.pose1, params_.table_height_mm,
+                                             params_.table_extent_mm.data());
+        if (t.over) under_table = std::max(under_table, t.depth_mm);
+      }
       const FingerContacts::ShapeLoad& l = contacts_.load(k);
       const Vec3 f = shape_normal_vec_n_[k] + l.friction_n;
       const bool touching = shape_normal_n_[k] > 0 || l.nodes > 0;
@@ -403,6 +408,7 @@ void World::fill_state_rt() noexcept {
     out.palm_force_n[1] = static_cast<float>(palm.y);
     out.palm_force_n[2] = static_cast<float>(palm.z);
     out.palm_contact = palm_contact ? 1 : 0;
+    state_.under_table_mm[s] = static_cast<float>(under_table);
   }
   // Nodes resting on the table (within 0.05 mm of lying on it) and their share of the area.
   const auto x = sheet_->positions();

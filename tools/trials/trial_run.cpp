@@ -236,6 +236,9 @@ TrialResult run_trial(const TrialOptions& o, int index, std::uint64_t seed) {
               }
             }
           for (int h = 0; h < 2; ++h) r.max_force_n[h] = std::max(r.max_force_n[h], window_force[h]);
+          for (int h = 0; h < 2; ++h)
+            r.max_under_table_mm[h] =
+                std::max(r.max_under_table_mm[h], double(world_state->value().under_table_mm[h]));
         }
         for (int h = 0; h < 2; ++h)
           if (hand_status[h]->poll().has_data())
@@ -496,6 +499,7 @@ nlohmann::json to_json(const TrialResult& r) {
           {"hands_clear", r.hands_clear},
           {"min_tip_z_mm", num(r.min_tip_z_mm)},
           {"max_force_n", {num(r.max_force_n[0]), num(r.max_force_n[1])}},
+          {"max_under_table_mm", {num(r.max_under_table_mm[0]), num(r.max_under_table_mm[1])}},
           {"success", r.success},
           {"failure", r.failure},
           {"timeline", timeline},
@@ -539,6 +543,10 @@ TrialResult from_json(const nlohmann::json& j) {
   r.min_tip_z_mm = num(j.at("min_tip_z_mm"));
   r.max_force_n[0] = num(j.at("max_force_n")[0]);
   r.max_force_n[1] = num(j.at("max_force_n")[1]);
+  if (j.contains("max_under_table_mm")) {  // results written before it: 0
+    r.max_under_table_mm[0] = num(j.at("max_under_table_mm")[0]);
+    r.max_under_table_mm[1] = num(j.at("max_under_table_mm")[1]);
+  }
   r.success = j.at("success").get<bool>();
   r.failure = j.at("failure").get<std::string>();
   for (const auto& e : j.at("timeline"))

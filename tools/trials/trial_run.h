@@ -106,6 +106,9 @@ struct TrialResult {
   bool hands_clear = false;  // at the end (world truth): no fingertip or palm touching, every tip 20 mm up or more
   double min_tip_z_mm = 0;
   double max_force_n[2] = {0, 0};  // the largest fingertip normal force of each hand over the trial
+  // How deep each arm's links, wrist and forearm reached under the table's top over the trial
+  // (world_state; the world's arms are kinematic and pass through it, a real one would not).
+  double max_under_table_mm[2] = {0, 0};
   bool success = false;
   std::string failure;       // the first reason it is not a success ("" for a success)
   std::vector<TimelineEntry> timeline;

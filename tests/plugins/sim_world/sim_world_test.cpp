@@ -1,7 +1,7 @@
 // The world's step as a unit: one seed, one trajectory (bit for bit); bad commands clamped,
 // refused and counted; a non-finite step rolled back; the fastest motions the drives allow
 // never put a finger more than 1 mm into the sheet or the table; a step allocates nothing; the
-// sheet exported as a SheetState.
+// sheet exported as a SheetState; how deep the kinematic arms reach under the table.
 #include "plugins/sim_world/sim_world.h"
 
 #include <doctest/doctest.h>
@@ -187,4 +187,31 @@ TEST_CASE("a world step with a hand pressing the sheet allocates nothing; the sh
   CHECK(sheet_state->position_mm[600][2] == static_cast<float>(x[600].z));
   CHECK(sheet_state->normal[600][2] > 0.99f);  // flat on the table, printed face up
   CHECK(rig.world->state().sheet_table_contact_area_mm2 == doctest::Approx(210.0 * 297.0).epsilon(0.02));
+}
+
+TEST_CASE(
+    "world_state reports per side how deep the kinematic arm and forearm reach under the table's "
+    "top") {
+  WorldState pressing;
+  (void)run(nominal(), &pressing);  // the right index presses the sheet on the table
+  MESSAGE("pressing: under the table right " << pressing.under_table_mm[0] << " mm, left "
+                                             << pressing.under_table_mm[1]);
+  CHECK(pressing.under_table_mm[0] == 0.0f);
+  CHECK(pressing.under_table_mm[1] == 0.0f);
+  CHECK(pressing.all_finite());
+  // The same hand pose with the table 300 mm higher (the hand's contacts off, so that nothing
+  // stops the fingers): the right wrist and forearm are under its top (and the parked left
+  // arm partly: 300 mm is over its lowest link).
+  WorldParams raised = nominal();
+  raised.hand_contacts = false;
+  raised.table_height_mm = 300.0;
+  const Vec3 above{20, 40, 8};
+  Rig rig(raised, "ffpad", above, palm_forward_down(robot::Side::right, deg(30)), index_out());
+  rig.hold(0.05);
+  const WorldState& s = rig.world->state();
+  MESSAGE("table raised 300 mm: under the table right " << s.under_table_mm[0] << " mm, left "
+                                                        << s.under_table_mm[1]);
+  CHECK(s.under_table_mm[0] > 100.0f);
+  CHECK(s.under_table_mm[0] < 400.0f);
+  CHECK(s.all_finite());
 }

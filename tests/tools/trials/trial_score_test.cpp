@@ -282,7 +282,10 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   b.sheet_nodes_u = 2;
   b.sheet_nodes_v = 1;
   b.sheet_end_mm = {{1.5f, -2.0f, 0.25f}, {16.5f, -2.0f, 0.25f}};
+  b.max_under_table_mm[0] = 63.5;
   const TrialResult back = from_json(to_json(b));
+  CHECK(back.max_under_table_mm[0] == 63.5);  // how deep the right arm went under the table
+  CHECK(back.max_under_table_mm[1] == 0.0);
   CHECK(row(back) == row(b));
   // ... the worst edge's place and the sheet the score was taken from.
   CHECK(back.score.stretch_at_mm[0] == 52.5);
