@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -35,6 +36,7 @@ namespace crease::trials {
 namespace {
 
 constexpr double kClearMm = 20.0;        // hands clear: every fingertip at least this high
+constexpr double kUnderTableMm = 1.0;    // an arm deeper under the table's top: no success
 constexpr double kTouchN = 0.05;         // a fingertip pressing more than this touches
 constexpr double kAbortWaitS = 90.0;     // the retreat of an operator abort ends within this
 
@@ -143,6 +145,13 @@ void judge(TrialResult& r) {
     r.failure = r.score.miss;
   } else if (!r.hands_clear) {
     r.failure = "a hand not clear of the sheet at the end";
+  } else if (std::max(r.max_under_table_mm[0], r.max_under_table_mm[1]) > kUnderTableMm) {
+    // The world's arms pass through the table; a real arm would have hit it.
+    const int h = r.max_under_table_mm[0] >= r.max_under_table_mm[1] ? 0 : 1;
+    char b[96];
+    std::snprintf(b, sizeof b, "the %s arm %.1f mm under the table's top",
+                  h == 0 ? "right" : "left", r.max_under_table_mm[h]);
+    r.failure = b;
   } else {
     r.success = true;
     r.failure.clear();

@@ -108,7 +108,7 @@ struct TrialResult {
   double max_force_n[2] = {0, 0};  // the largest fingertip normal force of each hand over the trial
   // How deep each arm's links, wrist and forearm reached under the table's top over the trial
   // (world_state; the world's arms are kinematic and pass through it, a real one would not).
-  double max_under_table_mm[2] = {0, 0};
+  double max_under_table_mm[2] = {0, 0};  // over 1 mm: no success
   bool success = false;
   std::string failure;       // the first reason it is not a success ("" for a success)
   std::vector<TimelineEntry> timeline;

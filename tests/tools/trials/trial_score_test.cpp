@@ -261,6 +261,13 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(line.find("mean_s=21.0") != std::string::npos);
   CHECK(row(b).find("why=\"aborted in fold/shift/approach: device_fault; sheet: no fold") != std::string::npos);
   CHECK(row(a).find("success=1") != std::string::npos);
+  // The same fold with the right arm through the table on the way (the world lets it pass): no
+  // success, and the failure says so.
+  TrialResult c = a;
+  c.max_under_table_mm[0] = 74.0;
+  judge(c);
+  CHECK_FALSE(c.success);
+  CHECK(c.failure == "the right arm 74.0 mm under the table's top");
   // The JSON round trip keeps what the table shows.
   b.series.push_back({0.5,
                       {1.5, 2.0},
