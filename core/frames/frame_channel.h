@@ -16,8 +16,11 @@
 // hot-swap the new instance's worker waits (wait_signal) until the old one released it.
 // Images are rows packed (stride = width * bytes_per_pixel): 8-bit grey for the colour cameras'
 // sets; a depth source's sets carry 16-bit depth and 8-bit BGR images (bytes_per_pixel 2 and 3).
+// Each image also carries where its camera stood when it was captured (CameraPose): a camera the
+// robot carries moves between sets, so its pose travels with its pixels, in the same buffer.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -39,6 +42,20 @@ struct CameraSpec {
   friend bool operator==(const CameraSpec&, const CameraSpec&) = default;
 };
 
+inline constexpr std::size_t kMaxImages = 32;  // images of one set (valid_mask bits)
+
+// Where the camera of an image stood at the image's capture, in the world (mm):
+//   x_world = rotation * x_camera + translation_mm   (rotation row by row, world-from-camera)
+// carried false: the camera is fixed in the world and its calibration says where (rotation and
+// translation_mm are not used). A writer whose camera moves (a wrist camera) sets carried and
+// the pose of that capture; the reader checks it (a non-finite pose is the writer's bug or a bad
+// recording, never trusted).
+struct CameraPose {
+  bool carried = false;
+  double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  double translation_mm[3] = {0, 0, 0};
+};
+
 // One buffer of the triple buffer: a frame set and what the writer said about it.
 class FrameSet {
  public:
@@ -58,15 +75,26 @@ class FrameSet {
   [[nodiscard]] bool valid(std::size_t camera) const noexcept {
     return ((valid_mask >> camera) & 1u) != 0;
   }
+  // Image k's camera pose at this set's capture. The writer sets every image's before publish
+  // (a set is reused: a pose not set is the one this buffer carried three publishes ago).
+  [[nodiscard]] CameraPose& pose(std::size_t camera) noexcept {
+    CREASE_DEBUG_ASSERT(camera < kMaxImages);
+    return poses_[camera];
+  }
+  [[nodiscard]] const CameraPose& pose(std::size_t camera) const noexcept {
+    CREASE_DEBUG_ASSERT(camera < kMaxImages);
+    return poses_[camera];
+  }
 
  private:
   friend class FrameChannel;
   std::vector<std::unique_ptr<std::uint8_t[]>> images_;
+  std::array<CameraPose, kMaxImages> poses_{};  // allocated with the set: 3.3 kB
 };
 
 class FrameChannel {
  public:
-  static constexpr std::size_t kMaxCameras = 32;  // valid_mask bits
+  static constexpr std::size_t kMaxCameras = kMaxImages;  // valid_mask bits
   // The channel's type as ports list it (its cameras say the rest).
   static constexpr char kTypeName[] = "crease.FrameSet";
   static constexpr std::uint32_t kTypeVersion = 1;

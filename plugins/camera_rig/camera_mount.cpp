@@ -1,6 +1,7 @@
 #include "plugins/camera_rig/camera_mount.h"
 
 #include <array>
+#include <cmath>
 #include <opencv2/core/persistence.hpp>
 #include <string_view>
 
@@ -100,6 +101,39 @@ void place_on_mount(const cv::Matx33d& mount_R, const cv::Vec3d& mount_t,
   // x_cam = mount_R * shape_R^T * (x_world - shape_p) + mount_t.
   R = mount_R * shape_R.t();
   t = mount_t - R * shape_p;
+}
+
+crease::frames::CameraPose carried_pose(const cv::Matx33d& R, const cv::Vec3d& t) noexcept {
+  // x_world = R^T (x_cam - t): world-from-camera rotation R^T, the camera's centre -R^T t.
+  crease::frames::CameraPose p;
+  p.carried = true;
+  const cv::Matx33d Rt = R.t();
+  const cv::Vec3d c = -(Rt * t);
+  for (int k = 0; k < 9; ++k) p.rotation[k] = Rt.val[k];
+  for (int k = 0; k < 3; ++k) p.translation_mm[k] = c[k];
+  return p;
+}
+
+bool camera_from_pose(const crease::frames::CameraPose& pose, cv::Matx33d& R,
+                      cv::Vec3d& t) noexcept {
+  cv::Matx33d wc;  // world-from-camera
+  cv::Vec3d c;
+  for (int k = 0; k < 9; ++k) {
+    if (!std::isfinite(pose.rotation[k])) return false;
+    wc.val[k] = pose.rotation[k];
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (!std::isfinite(pose.translation_mm[k])) return false;
+    c[k] = pose.translation_mm[k];
+  }
+  const cv::Matx33d g = wc.t() * wc;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (std::abs(g(i, j) - (i == j ? 1.0 : 0.0)) > 1e-6) return false;
+  if (cv::determinant(wc) < 0) return false;
+  R = wc.t();
+  t = -(R * c);
+  return true;
 }
 
 }  // namespace crease::vision

@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 
+#include "core/frames/frame_channel.h"
 #include "core/port_types/world_shapes.h"
 
 namespace crease::vision {
@@ -44,5 +45,15 @@ void save_camera_mount(const CameraMount& mount, const std::string& path);
 void place_on_mount(const cv::Matx33d& mount_R, const cv::Vec3d& mount_t,
                     const cv::Matx33d& shape_R, const cv::Vec3d& shape_p, cv::Matx33d& R,
                     cv::Vec3d& t) noexcept;
+
+// A frame's camera pose (core/frames/frame_channel.h: world-from-camera, carried) of a camera
+// whose world -> camera pose this capture is (R, t). RT-safe.
+[[nodiscard]] crease::frames::CameraPose carried_pose(const cv::Matx33d& R,
+                                                      const cv::Vec3d& t) noexcept;
+// The world -> camera pose (R, t) of a frame's carried camera pose; false, R and t untouched,
+// when any entry is not finite or the rotation is not one (|R^T R - I| > 1e-6 in an entry, or
+// det R < 0). RT-safe.
+[[nodiscard]] bool camera_from_pose(const crease::frames::CameraPose& pose, cv::Matx33d& R,
+                                    cv::Vec3d& t) noexcept;
 
 }  // namespace crease::vision

@@ -6,15 +6,17 @@
 // (f baseline), Intel's D400 figure). Until the port has a value the cameras see the empty table.
 // A camera whose calibration names a mount (plugins/camera_rig/camera_mount.h: a wrist camera) is
 // rendered each frame from where the `world_shapes` port puts its mount shape; until that shape
-// has been received its images are empty (the camera invalid in the set) and counted.
+// has been received its images are empty (the camera invalid in the set) and counted. The pose it
+// was rendered from travels with its images (the set's CameraPose) to depth_tracking.
 // Parameters: cameras: DIR (cam0.yaml.. with depth_unit_mm), sheet: plain | markers (layout:
 // for markers), sheet_colour: {b, g, r} (plain), seed, noise (grey levels), blur_px, occluders,
 // frame_period_s, depth_noise (bool), sensor: d435 | d405 (the defaults of the next six),
 // baseline_mm, subpixel, max_incidence_deg, edge_jump_mm, min_range_mm, max_range_mm,
 // table_z_mm, hand_height_mm (the random occluders'), world_shapes (bool, default false: the
 // world's arms and hands of the `world_shapes` port at their real depth, skin-coloured; must be
-// true with a carried camera); and camera_plugin.h's (`record`: not with a carried camera, whose
-// pose per frame the replay layout has no place for).
+// true with a carried camera); and camera_plugin.h's (`record`: a carried camera's pose per
+// frame goes to camK/poses.csv, plugins/cameras/camera_source.h). Each frame set carries every
+// carried camera's pose of that capture beside its images (core/frames/frame_channel.h).
 // Inputs: sheet_truth (crease::SheetState), world_shapes (crease::WorldShapes, with
 // `world_shapes: true`). Outputs: depth_images (frames), depth_frames; with a carried camera
 // carried_unposed (crease::Figure: the share of carried cameras' frames left empty for want of
@@ -75,7 +77,6 @@ class CameraDepthSimPlugin final : public CameraPlugin {
       const std::string what = c.camera.name + " is carried (" + describe(*c.mount) + ")";
       if (!p.get<bool>("world_shapes", false))
         p.fail("world_shapes", "must be true: " + what + " and moves with the world's shapes");
-      if (p.has("record")) p.fail("record", what + ": its pose per frame has no replay layout");
     }
     truth_.bind(ports);
     shapes_.bind(p, ports);

@@ -20,6 +20,10 @@ std::string replay_frame_path(const std::string& dir, std::size_t cam, std::uint
   return dir + name;
 }
 
+std::string replay_poses_path(const std::string& dir, std::size_t cam) {
+  return dir + "/cam" + std::to_string(cam) + "/poses.csv";
+}
+
 std::string replay_colour_path(const std::string& dir, std::size_t cam, std::uint64_t index) {
   char name[64];
   std::snprintf(name, sizeof name, "/cam%zu/%06" PRIu64 ".colour.png", cam, index);
@@ -138,19 +142,30 @@ bool V4l2Source::grab(Frame& frame) {
 }
 
 Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras,
-                   const std::vector<double>& depth_units_mm)
+                   const std::vector<double>& depth_units_mm,
+                   const std::vector<std::optional<CameraMount>>& mounts)
     : dir_(dir), ncam_(cameras.size()), depth_(!depth_units_mm.empty()) {
   if (depth_ && depth_units_mm.size() != cameras.size())
     throw crease::Error(dir + ": " + std::to_string(depth_units_mm.size()) + " depth units for " +
                         std::to_string(cameras.size()) + " cameras");
+  if (!mounts.empty() && (!depth_ || mounts.size() != cameras.size()))
+    throw crease::Error(dir +
+                        ": carried cameras are recorded by an RGB-D source, one mount per camera");
   std::filesystem::create_directories(dir);
+  poses_.assign(cameras.size(), nullptr);
   for (std::size_t k = 0; k < cameras.size(); ++k) {
     std::filesystem::create_directories(dir + "/cam" + std::to_string(k));
     const std::string yaml = dir + "/cam" + std::to_string(k) + ".yaml";
+    const std::optional<CameraMount> mount = k < mounts.size() ? mounts[k] : std::nullopt;
     if (depth_)
-      save_depth_camera(DepthCamera{cameras[k], depth_units_mm[k]}, yaml);
+      save_depth_camera(DepthCamera{cameras[k], depth_units_mm[k], mount}, yaml);
     else
       save_camera(cameras[k], yaml);
+    if (!mount) continue;
+    const std::string csv = replay_poses_path(dir, k);
+    poses_[k] = std::fopen(csv.c_str(), "w");
+    if (poses_[k] == nullptr) throw crease::Error(csv + ": cannot open for writing");
+    std::fprintf(poses_[k], "%s\n", kReplayPosesHeader);
   }
   const std::string csv = dir + "/timestamps.csv";
   stamps_ = std::fopen(csv.c_str(), "w");
@@ -160,19 +175,34 @@ Recorder::Recorder(const std::string& dir, const std::vector<Camera>& cameras,
 
 Recorder::~Recorder() {
   if (stamps_ != nullptr) std::fclose(stamps_);
+  for (std::FILE* f : poses_)
+    if (f != nullptr) std::fclose(f);
 }
 
 void Recorder::write(const Frame& frame) {
   // Grey: image k is camera k's; depth: images 2k (depth) and 2k + 1 (colour) are camera k's.
   const std::size_t per = depth_ ? 2 : 1;
-  for (std::size_t k = 0; k < ncam_; ++k)
+  for (std::size_t k = 0; k < ncam_; ++k) {
+    bool delivered = false;
     for (std::size_t i = 0; i < per && per * k + i < frame.images.size(); ++i) {
       const cv::Mat& m = frame.images[per * k + i];
       if (m.empty()) continue;
+      delivered = true;
       const std::string p = i == 0 ? replay_frame_path(dir_, k, frame.index)
                                    : replay_colour_path(dir_, k, frame.index);
       if (!cv::imwrite(p, m)) throw crease::Error(p + ": write failed");
     }
+    // A carried camera's pose of this capture, when it delivered (a camera not posed yet has
+    // neither images nor pose).
+    if (poses_[k] == nullptr || !delivered || per * k >= frame.poses.size()) continue;
+    const crease::frames::CameraPose& pose = frame.poses[per * k];
+    if (!pose.carried) continue;
+    std::fprintf(poses_[k], "%" PRIu64, frame.index);
+    for (const double r : pose.rotation) std::fprintf(poses_[k], ",%.17g", r);
+    for (const double x : pose.translation_mm) std::fprintf(poses_[k], ",%.17g", x);
+    std::fprintf(poses_[k], "\n");
+    std::fflush(poses_[k]);
+  }
   std::fprintf(stamps_, "%" PRIu64 ",%" PRId64 "\n", frame.index, frame.timestamp_ns);
   std::fflush(stamps_);
 }

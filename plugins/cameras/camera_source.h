@@ -8,6 +8,13 @@
 //   DIR/camK.yaml            its calibration with `depth_unit_mm` (what marks a depth recording)
 //   DIR/camK/NNNNNN.png      its depth (16-bit PNG, counts of depth_unit_mm, 0 = no depth)
 //   DIR/camK/NNNNNN.colour.png  its registered colour image (8-bit BGR)
+// and of a camera the robot carries (its calibration with the mount keys of
+// plugins/camera_rig/camera_mount.h, its rotation / translation relative to the mount shape):
+//   DIR/camK/poses.csv       the header `frame,r00,r01,r02,r10,r11,r12,r20,r21,r22,x_mm,y_mm,z_mm`,
+//                            then per frame it delivered `INDEX,` and its world-from-camera pose
+//                            at that capture (core/frames/frame_channel.h's CameraPose: rotation
+//                            row by row, the camera's centre in mm), each number printed %.17g so
+//                            that it reads back bit-identical
 // A camera that delivers nothing this frame leaves its image empty; the others go on.
 // Not RT code (file and device I/O, OpenCV allocation): run it on a vision worker thread.
 #pragma once
@@ -15,14 +22,15 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <opencv2/videoio.hpp>
-
 #include "core/frames/frame_channel.h"
 #include "plugins/camera_rig/camera_model.h"
+#include "plugins/camera_rig/camera_mount.h"
 #include "plugins/camera_rig/images_port.h"
 
 namespace crease::vision {
@@ -36,6 +44,9 @@ struct Frame {
   // Set by the caller: images[k] are buffers of the right size to write into (a frame channel's
   // set); a source that can fill them in place does (SimSource), instead of fresh buffers.
   bool fill_in_place = false;
+  // One per image (as images) where the source's cameras move: each image's camera pose at this
+  // capture. Empty: every camera fixed (its calibration says where).
+  std::vector<crease::frames::CameraPose> poses;
 };
 
 class CameraSource {
@@ -49,6 +60,9 @@ class CameraSource {
   }
   // An RGB-D source's depth unit per camera (mm per count); empty for grey cameras.
   [[nodiscard]] virtual std::vector<double> depth_units_mm() const { return {}; }
+  // Per camera, the mount of one the robot carries (plugins/camera_rig/camera_mount.h; its
+  // calibration is relative to it); empty or nullopt: fixed.
+  [[nodiscard]] virtual std::vector<std::optional<CameraMount>> mounts() const { return {}; }
   // Fills the next frame; false at the end of a recording (or when no camera delivers).
   virtual bool grab(Frame& frame) = 0;
   // Any thread: asks a grab() that waits (a replay pacing its frames) to return soon, and every
@@ -61,6 +75,10 @@ class CameraSource {
 // DIR/camK/NNNNNN.colour.png: the colour image of a depth recording's frame.
 [[nodiscard]] std::string replay_colour_path(const std::string& dir, std::size_t cam,
                                              std::uint64_t index);
+// DIR/camK/poses.csv: a carried camera's pose per frame, and that file's header.
+[[nodiscard]] std::string replay_poses_path(const std::string& dir, std::size_t cam);
+inline constexpr char kReplayPosesHeader[] =
+    "frame,r00,r01,r02,r10,r11,r12,r20,r21,r22,x_mm,y_mm,z_mm";
 
 // How a live camera that did not open, or stopped delivering, is brought back: the capture
 // worker (inside grab()) retries opening it `initial_s` after the failure, doubling the wait
@@ -125,9 +143,12 @@ class V4l2Source final : public CameraSource {
 // Writes frames in the replay layout (the `record` option of every source).
 class Recorder {
  public:
-  // depth_units_mm empty: grey cameras; else one per camera: an RGB-D source's layout.
+  // depth_units_mm empty: grey cameras; else one per camera: an RGB-D source's layout. mounts:
+  // per camera (or empty) the mount of a carried camera: its calibration is saved with the mount
+  // keys and its pose per frame (Frame::poses) in camK/poses.csv (an RGB-D source's only).
   Recorder(const std::string& dir, const std::vector<Camera>& cameras,
-           const std::vector<double>& depth_units_mm = {});
+           const std::vector<double>& depth_units_mm = {},
+           const std::vector<std::optional<CameraMount>>& mounts = {});
   void write(const Frame& frame);
 
  private:
@@ -135,6 +156,7 @@ class Recorder {
   std::size_t ncam_;
   bool depth_ = false;
   std::FILE* stamps_ = nullptr;
+  std::vector<std::FILE*> poses_;  // per camera: its poses.csv, nullptr when fixed
 
  public:
   ~Recorder();

@@ -29,8 +29,8 @@ CameraWorker::CameraWorker(std::unique_ptr<CameraSource> source,
   CREASE_DEMAND(channel_->cameras() == source_->channel_images(),
                 "the frame channel does not have this source's cameras");
   if (!record_dir.empty())
-    recorder_ =
-        std::make_unique<Recorder>(record_dir, source_->cameras(), source_->depth_units_mm());
+    recorder_ = std::make_unique<Recorder>(record_dir, source_->cameras(),
+                                           source_->depth_units_mm(), source_->mounts());
   writer_ = channel_->try_claim_writer();  // now if free, so the first request need not wait
   thread_ = std::thread([this] { run(); });
 }
@@ -100,6 +100,9 @@ void CameraWorker::point_at_write_set() {
 std::uint32_t CameraWorker::copy_into_channel() {
   crease::frames::FrameSet& set = channel_->write_slot();
   std::uint32_t valid = 0;
+  // Every image's pose, delivered or not: the set is reused and would keep an old one.
+  for (std::size_t k = 0; k < channel_->cameras().size(); ++k)
+    set.pose(k) = k < frame_.poses.size() ? frame_.poses[k] : crease::frames::CameraPose{};
   for (std::size_t k = 0; k < channel_->cameras().size() && k < frame_.images.size(); ++k) {
     const cv::Mat& im = frame_.images[k];
     const auto& spec = channel_->cameras()[k];

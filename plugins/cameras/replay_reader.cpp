@@ -1,7 +1,9 @@
 #include "plugins/cameras/replay_reader.h"
 
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -74,6 +76,58 @@ std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::
   return out;
 }
 
+std::vector<RecordedPose> parse_poses(const std::string& text, const std::string& file) {
+  std::vector<RecordedPose> out;
+  std::istringstream in(text);
+  std::string line;
+  int lineno = 0;
+  auto fail = [&](const std::string& why) {
+    throw crease::ConfigError(file + ": line " + std::to_string(lineno) + ": " + why);
+  };
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (lineno == 1) {
+      if (line != kReplayPosesHeader)
+        fail(std::string("the header must be exactly '") + kReplayPosesHeader + "', not '" + line +
+             "'");
+      continue;
+    }
+    if (line.empty()) continue;
+    RecordedPose r;
+    r.pose.carried = true;
+    std::size_t comma = line.find(',');
+    if (comma == std::string::npos || !parse_uint(line, 0, comma, r.frame))
+      fail("expected 'FRAME,' and twelve numbers with a non-negative integer frame index, not '" +
+           line + "'");
+    for (int k = 0; k < 12; ++k) {
+      const std::size_t begin = comma + 1;
+      comma = line.find(',', begin);
+      const std::size_t end = comma == std::string::npos ? line.size() : comma;
+      if ((k < 11) != (comma != std::string::npos))
+        fail(
+            "expected twelve numbers after the frame index (rotation row by row, x_mm, y_mm, "
+            "z_mm), not '" +
+            line + "'");
+      const std::string field = line.substr(begin, end - begin);
+      char* stop = nullptr;
+      const double v = field.empty() ? 0.0 : std::strtod(field.c_str(), &stop);
+      if (field.empty() || stop != field.c_str() + field.size() || !std::isfinite(v))
+        fail("number " + std::to_string(k + 1) + " '" + field + "' is not a finite number");
+      (k < 9 ? r.pose.rotation[k] : r.pose.translation_mm[k - 9]) = v;
+    }
+    if (!out.empty() && r.frame <= out.back().frame)
+      fail("frame " + std::to_string(r.frame) + " after frame " + std::to_string(out.back().frame) +
+           ": frame indices must increase");
+    out.push_back(r);
+  }
+  if (lineno == 0) {
+    lineno = 1;
+    fail(std::string("empty file: expected the header '") + kReplayPosesHeader + "'");
+  }
+  return out;
+}
+
 ReplayReader::ReplayReader(const std::string& dir) : dir_(dir) {
   // A depth recording's calibrations carry depth_unit_mm (camera_source.h's layout).
   bool depth = false;
@@ -88,7 +142,11 @@ ReplayReader::ReplayReader(const std::string& dir) : dir_(dir) {
   if (depth) {
     const std::vector<DepthCamera> cams = load_depth_camera_dir(dir);
     cameras_ = cameras_of(cams);
-    for (const DepthCamera& c : cams) depth_units_mm_.push_back(c.depth_unit_mm);
+    for (const DepthCamera& c : cams) {
+      depth_units_mm_.push_back(c.depth_unit_mm);
+      mounts_.push_back(c.mount);
+      any_carried_ = any_carried_ || c.mount.has_value();
+    }
   } else {
     cameras_ = load_camera_dir(dir);
   }
@@ -98,6 +156,28 @@ ReplayReader::ReplayReader(const std::string& dir) : dir_(dir) {
   std::ostringstream text;
   text << in.rdbuf();
   stamps_ = parse_timestamps(text.str(), csv);
+  // Carried cameras: their pose per recorded frame, by frame index (a pose of a frame not in
+  // timestamps.csv is never played).
+  poses_.assign(cameras_.size(), {});
+  for (std::size_t k = 0; k < mounts_.size(); ++k) {
+    if (!mounts_[k]) continue;
+    const std::string file = replay_poses_path(dir, k);
+    std::ifstream pin(file);
+    crease::require_input(static_cast<bool>(pin), file + ": cannot read (cam" + std::to_string(k) +
+                                                      ".yaml names a mount: a carried camera's "
+                                                      "recording has its pose per frame)");
+    std::ostringstream ptext;
+    ptext << pin.rdbuf();
+    const std::vector<RecordedPose> recorded = parse_poses(ptext.str(), file);
+    auto& per_frame = poses_[k];
+    per_frame.assign(stamps_.size(), crease::frames::CameraPose{});
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < stamps_.size(); ++i) {
+      while (j < recorded.size() && recorded[j].frame < stamps_[i].frame) ++j;
+      if (j < recorded.size() && recorded[j].frame == stamps_[i].frame)
+        per_frame[i] = recorded[j].pose;
+    }
+  }
 }
 
 void ReplayReader::read(std::size_t i, Frame& frame) const {
@@ -108,6 +188,12 @@ void ReplayReader::read(std::size_t i, Frame& frame) const {
   const bool depth = !depth_units_mm_.empty();
   const std::size_t per = depth ? 2 : 1;  // depth: camera k's depth at 2k, its colour at 2k + 1
   frame.images.resize(per * cameras_.size());
+  frame.poses.clear();
+  if (any_carried_) {
+    frame.poses.assign(per * cameras_.size(), crease::frames::CameraPose{});
+    for (std::size_t k = 0; k < cameras_.size(); ++k)
+      if (mounts_[k]) frame.poses[2 * k] = frame.poses[2 * k + 1] = poses_[k][i];
+  }
   const auto load = [](const std::string& p, int flags, int type, const Camera& c) {
     cv::Mat m = std::filesystem::exists(p) ? cv::imread(p, flags) : cv::Mat();
     if (!m.empty() && (m.cols != c.width || m.rows != c.height || m.type() != type)) m = cv::Mat();
@@ -117,6 +203,11 @@ void ReplayReader::read(std::size_t i, Frame& frame) const {
     const Camera& c = cameras_[k];
     if (!depth) {
       frame.images[k] = load(replay_frame_path(dir_, k, s.frame), cv::IMREAD_GRAYSCALE, CV_8UC1, c);
+      continue;
+    }
+    if (mounts_[k] && !poses_[k][i].carried) {  // a carried camera with no pose: nothing
+      frame.images[2 * k] = cv::Mat();
+      frame.images[2 * k + 1] = cv::Mat();
       continue;
     }
     frame.images[2 * k] =

@@ -125,6 +125,7 @@ bool ReplaySource::grab(Frame& frame) {
   frame.timestamp_ns = due;  // re-based: the replay's start + the recorded interval since frame 0
   frame.images.resize(f.images.size());
   for (std::size_t k = 0; k < f.images.size(); ++k) frame.images[k] = std::move(f.images[k]);
+  frame.poses = std::move(f.poses);  // a carried camera's recorded pose per image (or none)
   played_.fetch_add(1, std::memory_order_acq_rel);
   return true;
 }

@@ -53,6 +53,10 @@ class ReplaySource final : public CameraSource {
   [[nodiscard]] std::vector<double> depth_units_mm() const override {
     return reader_.depth_units_mm();
   }
+  // A depth recording's carried cameras (their poses per frame play with their images).
+  [[nodiscard]] std::vector<std::optional<CameraMount>> mounts() const override {
+    return reader_.any_carried() ? reader_.mounts() : std::vector<std::optional<CameraMount>>{};
+  }
   // The next frame, paced and re-based as above; false after the last one or once cancelled.
   // Throws crease::Error when the decoder failed.
   bool grab(Frame& frame) override;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plugins/camera_rig/camera_mount.h"
 #include "plugins/depth_tracking/cpd_params.h"
 #include "rt/clock.h"
 
@@ -45,6 +46,11 @@ void DepthTracker::configure(const TrackerParams& p, const std::vector<vision::D
   cp.camera_depth_unit_mm.clear();
   for (const auto& c : cameras) cp.camera_depth_unit_mm.push_back(c.depth_unit_mm);
   const std::vector<vision::Camera> cams = vision::cameras_of(cameras);
+  cams_ = cams;
+  carried_.clear();
+  for (const auto& c : cameras) carried_.push_back(c.mount ? 1 : 0);
+  views_ = bad_pose_views_ = 0;
+  bad_pose_mask_ = 0;
   std::size_t pixels = 0;
   for (const auto& c : cams) pixels += static_cast<std::size_t>(c.width) * static_cast<std::size_t>(c.height);
   cloud_.configure(cp, cams, static_cast<int>(std::min<std::size_t>(pixels, 50000000)));
@@ -77,8 +83,9 @@ void DepthTracker::mark_hidden_margin() noexcept {
     }
 }
 
-bool DepthTracker::process(std::span<const cv::Mat> depth, std::span<const cv::Mat> bgr, const SheetState& model,
-                           std::int64_t stamp_ns, std::uint64_t frame, DepthTargets& out) noexcept {
+bool DepthTracker::process(std::span<const cv::Mat> depth, std::span<const cv::Mat> bgr,
+                           const SheetState& model, std::int64_t stamp_ns, std::uint64_t frame,
+                           DepthTargets& out, std::span<const frames::CameraPose> poses) noexcept {
   out.timestamp_ns = stamp_ns;
   out.frame = frame;
   out.count = 0;
@@ -89,10 +96,22 @@ bool DepthTracker::process(std::span<const cv::Mat> depth, std::span<const cv::M
   out.cameras_ok = 0;
   const std::int64_t t0 = crease::rt::now_ns();
   cloud_.clear();
-  const std::size_t ncam = std::min(depth.size(), bgr.size());
+  const std::size_t ncam = std::min({depth.size(), bgr.size(), cams_.size()});
+  bad_pose_mask_ = 0;
   for (std::size_t k = 0; k < ncam; ++k) {
     if (depth[k].empty() || bgr[k].empty()) continue;
-    if (cloud_.add_view(static_cast<int>(k), depth[k], bgr[k])) out.cameras_ok |= 1u << k;
+    ++views_;
+    // Where the camera was at this capture: its frame's pose when it moves, else its calibration.
+    cv::Matx33d R = cams_[k].R;
+    cv::Vec3d t = cams_[k].t;
+    const bool posed = k < poses.size() && poses[k].carried;
+    if ((posed || carried_[k] != 0) && !(posed && vision::camera_from_pose(poses[k], R, t))) {
+      ++bad_pose_views_;
+      bad_pose_mask_ |= 1u << k;
+      continue;  // dropped: as if the camera delivered nothing
+    }
+    (void)vis_.set_pose(k, R, t);
+    if (cloud_.add_view(static_cast<int>(k), depth[k], bgr[k], R, t)) out.cameras_ok |= 1u << k;
   }
   cloud_.voxel_downsample();
   const std::int64_t t1 = crease::rt::now_ns();

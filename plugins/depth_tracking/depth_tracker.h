@@ -11,13 +11,13 @@
 // allocates, process() does not.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <span>
 #include <vector>
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
+#include "core/frames/frame_channel.h"
 #include "core/params.h"
 #include "core/port_types/depth_targets.h"
 #include "core/port_types/sheet_state.h"
@@ -63,10 +63,22 @@ class DepthTracker {
   void configure(const TrackerParams& params, const std::vector<vision::DepthCamera>& cameras);
 
   // depth[k], bgr[k]: camera k's images (empty Mats: nothing from it); model: the sheet model's
-  // newest state (its grid must be the configured one). Fills `out` (count 0 and false when
-  // nothing could be registered: no model, no cloud, a wrong grid). No allocation.
-  bool process(std::span<const cv::Mat> depth, std::span<const cv::Mat> bgr, const SheetState& model,
-               std::int64_t stamp_ns, std::uint64_t frame, DepthTargets& out) noexcept;
+  // newest state (its grid must be the configured one); poses[k]: where camera k was at this
+  // capture (core/frames/frame_channel.h; missing or not `carried`: a fixed camera, its
+  // calibration). A carried camera's view goes into the world, and its visibility is checked,
+  // from its frame's pose; a view whose pose is unusable (not finite, no rotation; or a camera
+  // calibrated as carried, camera_mount.h, whose frame came without a pose) is dropped and
+  // counted (bad_pose_views), as a camera that delivered nothing. Fills `out` (count 0 and false
+  // when nothing could be registered: no model, no cloud, a wrong grid). No allocation.
+  bool process(std::span<const cv::Mat> depth, std::span<const cv::Mat> bgr,
+               const SheetState& model, std::int64_t stamp_ns, std::uint64_t frame,
+               DepthTargets& out, std::span<const frames::CameraPose> poses = {}) noexcept;
+
+  // Camera views delivered (images present) and of those dropped for a bad pose, since configure.
+  [[nodiscard]] std::uint64_t views() const noexcept { return views_; }
+  [[nodiscard]] std::uint64_t bad_pose_views() const noexcept { return bad_pose_views_; }
+  // Bit k: camera k's view of the last process() was dropped for its pose.
+  [[nodiscard]] std::uint32_t last_bad_pose_mask() const noexcept { return bad_pose_mask_; }
 
   [[nodiscard]] const FrameTiming& timing() const noexcept { return timing_; }
   [[nodiscard]] const CloudBuilder& cloud() const noexcept { return cloud_; }
@@ -90,6 +102,10 @@ class DepthTracker {
   std::vector<std::uint8_t> near_hidden_;  // per node: within occlusion_margin of a hidden node
   CpdResult last_;
   FrameTiming timing_;
+  std::vector<vision::Camera> cams_;   // the calibrations (a fixed camera's pose)
+  std::vector<std::uint8_t> carried_;  // per camera: calibrated on a mount (needs a frame pose)
+  std::uint64_t views_ = 0, bad_pose_views_ = 0;
+  std::uint32_t bad_pose_mask_ = 0;
 };
 
 }  // namespace crease::depth

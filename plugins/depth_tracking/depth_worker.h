@@ -38,6 +38,14 @@ class DepthWorker {
   // RT-safe. Copies the newest result into `out` when there is one not yet taken.
   Take take_rt(crease::DepthTargets& out) noexcept { return worker_.take_rt(&out); }
   [[nodiscard]] std::uint64_t sets_processed() const noexcept { return worker_.sets_processed(); }
+  // Any thread (atomics): camera views delivered, and of those dropped for a bad pose (a carried
+  // camera's pose not finite, no rotation, or missing: DepthTracker::process).
+  [[nodiscard]] std::uint64_t views() const noexcept {
+    return views_.load(std::memory_order_acquire);
+  }
+  [[nodiscard]] std::uint64_t bad_pose_views() const noexcept {
+    return bad_pose_views_.load(std::memory_order_acquire);
+  }
   [[nodiscard]] std::string error() const { return worker_.error(); }  // non-RT, valid after `failed`
 
  private:
@@ -47,6 +55,8 @@ class DepthWorker {
   std::unique_ptr<crease::SheetState> model_buf_;  // worker thread
   std::unique_ptr<crease::DepthTargets> result_;   // worker thread
   std::vector<cv::Mat> depth_, bgr_;               // worker thread: headers over the set
+  std::vector<crease::frames::CameraPose> poses_;  // worker thread: per camera, its depth image's
+  std::atomic<std::uint64_t> views_{0}, bad_pose_views_{0};
   crease::rt::LatestChannel model_{sizeof(crease::SheetState)};
   crease::frames::FrameSetWorker worker_;  // last: its thread stops before the members above go
 };

@@ -123,6 +123,13 @@ void CloudBuilder::clear() noexcept {
 bool CloudBuilder::add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) noexcept {
   if (cam < 0 || cam >= static_cast<int>(cameras_.size())) return false;
   const vision::Camera& c = cameras_[static_cast<std::size_t>(cam)];
+  return add_view(cam, depth, bgr, c.R, c.t);
+}
+
+bool CloudBuilder::add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr, const cv::Matx33d& R,
+                            const cv::Vec3d& t_wc) noexcept {
+  if (cam < 0 || cam >= static_cast<int>(cameras_.size())) return false;
+  const vision::Camera& c = cameras_[static_cast<std::size_t>(cam)];
   if (depth.type() != CV_16UC1 || bgr.type() != CV_8UC3 || depth.rows != c.height ||
       depth.cols != c.width || bgr.rows != c.height || bgr.cols != c.width) {
     return false;
@@ -132,8 +139,8 @@ bool CloudBuilder::add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) n
   // world = R^T (p_cam - t)
   Eigen::Matrix3d rt;
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) rt(i, j) = c.R(j, i);
-  const Eigen::Vector3d t(c.t[0], c.t[1], c.t[2]);
+    for (int j = 0; j < 3; ++j) rt(i, j) = R(j, i);
+  const Eigen::Vector3d t(t_wc[0], t_wc[1], t_wc[2]);
   const int cap = static_cast<int>(points_.size());
   std::int64_t masked_out = 0, invalid_depth = 0, overflow = 0;  // in registers, not in counters_
   for (int v = 0; v < c.height; ++v) {

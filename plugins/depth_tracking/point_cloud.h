@@ -81,9 +81,13 @@ class CloudBuilder {
 
   void clear() noexcept;  // empties the cloud and the counters
   // Adds the masked, valid pixels of camera `cam`'s view: depth CV_16UC1 in depth units, colour
-  // CV_8UC3 BGR registered to it, both the camera's size. False (nothing added) on a wrong
-  // index, size or type. RT-safe.
+  // CV_8UC3 BGR registered to it, both the camera's size, put in the world with the camera's
+  // calibrated pose. False (nothing added) on a wrong index, size or type. RT-safe.
   bool add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr) noexcept;
+  // The same from where the camera was at this view's capture: (R, t) its world -> camera pose
+  // then (a camera the robot carries; the intrinsics, and so the ray table, do not move). RT-safe.
+  bool add_view(int cam, const cv::Mat& depth, const cv::Mat& bgr, const cv::Matx33d& R,
+                const cv::Vec3d& t) noexcept;
   // Replaces the cloud by one point per occupied voxel (the mean of its points, summed in the
   // order they were added); the order is that of the voxel keys (deterministic). RT-safe.
   void voxel_downsample() noexcept;

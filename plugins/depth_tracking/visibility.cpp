@@ -64,6 +64,13 @@ void NodeVisibility::set_depth_check(const std::vector<double>& depth_unit_mm, d
   occluder_mm_ = occluder_mm;
 }
 
+bool NodeVisibility::set_pose(std::size_t k, const cv::Matx33d& R, const cv::Vec3d& t) noexcept {
+  if (k >= views_.size()) return false;
+  views_[k].cam.R = R;  // the scaled intrinsics are the view's own: only the pose moves
+  views_[k].cam.t = t;
+  return true;
+}
+
 double NodeVisibility::farthest_depth_mm(const cv::Mat& depth, double unit_mm, double x,
                                          double y) const noexcept {
   const int cx = static_cast<int>(std::lround(x)), cy = static_cast<int>(std::lround(y));

@@ -30,6 +30,11 @@ class NodeVisibility {
   // with a measured surface nearer than itself by more than this is hidden (0: no such check).
   void set_depth_check(const std::vector<double>& depth_unit_mm, double occluder_mm);
 
+  // Camera k's world -> camera pose for the next compute() (a camera the robot carries: where
+  // it was at this frame's capture); its intrinsics stay. Until set, its calibrated pose.
+  // RT-safe; false on a wrong index.
+  bool set_pose(std::size_t k, const cv::Matx33d& R, const cv::Vec3d& t) noexcept;
+
   // nodes: the grid's world positions (mm). seen[i]: bit k set when camera k (of those in
   // camera_mask) sees node i. depth: per camera its depth image (CV_16UC1, full resolution; empty
   // or missing: no depth check for it). RT-safe; false on a wrong size.

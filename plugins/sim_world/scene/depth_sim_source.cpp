@@ -42,6 +42,7 @@ bool DepthSimSource::grab(Frame& frame) {
   frame.timestamp_ns = mesh.timestamp_ns >= 0 ? mesh.timestamp_ns
                                               : start_ns_ + static_cast<std::int64_t>(next_) * period_ns_;
   frame.images.resize(2 * cams_.size());
+  if (any_carried_) frame.poses.assign(2 * cams_.size(), crease::frames::CameraPose{});
   for (std::size_t k = 0; k < cams_.size(); ++k) {
     cv::Mat& depth = frame.images[2 * k];
     cv::Mat& bgr = frame.images[2 * k + 1];
@@ -54,6 +55,7 @@ bool DepthSimSource::grab(Frame& frame) {
         continue;
       }
       renderer_.set_pose(static_cast<int>(k), posed_[k].R, posed_[k].t);
+      frame.poses[2 * k] = frame.poses[2 * k + 1] = carried_pose(posed_[k].R, posed_[k].t);
     }
     renderer_.render(static_cast<int>(k), mesh, o, view_, shapes_);
     if (!frame.fill_in_place) {  // fresh buffers: the caller keeps the last ones

@@ -4,7 +4,8 @@
 // of plugins/camera_rig/depth_camera.h. The `camera_depth_sim` plugin feeds it the `sheet_truth`
 // port. A camera the robot carries (DepthCamera::mount: a wrist camera) is rendered each frame from
 // where the world's shapes of that frame put its mount shape (carried_camera.h); when they hold no
-// such shape (none received yet) its images are left empty (nothing delivered) and counted.
+// such shape (none received yet) its images are left empty (nothing delivered) and counted; each
+// frame carries the pose it was rendered from (Frame::poses) for the depth path and the recorder.
 // Not RT code: it runs on a camera worker thread.
 #pragma once
 
@@ -12,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "plugins/camera_rig/depth_camera.h"
@@ -40,7 +42,14 @@ class DepthSimSource final : public CameraSource {
   [[nodiscard]] std::vector<crease::frames::CameraSpec> channel_images() const override {
     return depth_channel_specs(cams_);
   }
-  bool grab(Frame& frame) override;  // never ends
+  [[nodiscard]] std::vector<std::optional<CameraMount>> mounts() const override {
+    std::vector<std::optional<CameraMount>> m;
+    for (const DepthCamera& c : depth_cams_) m.push_back(c.mount);
+    return m;
+  }
+  // Never ends. With a carried camera, frame.poses holds each image's camera pose: a carried
+  // camera's where it was rendered from (carried, world-from-camera), a fixed one's `fixed`.
+  bool grab(Frame& frame) override;
   // Before the first grab: `shapes_now(out)` fills OUT with the world's shapes to draw in the
   // next frame (empty: none), at their real depth (depth_view.h).
   void set_shapes_source(std::function<void(std::vector<SceneShape>&)> shapes_now) {

@@ -4,7 +4,8 @@
 // The D405-like wrist cameras (config/wrist_cameras, carried on the forearms): no set holds them
 // until the world's shapes come (each camera frame counted on `carried_unposed`), then both
 // deliver; the configuration errors of a carried camera (tests/plugins/sim_world/scene/
-// carried_camera_test.cpp: the images from the moved pose).
+// carried_camera_test.cpp: the images from the moved pose; `record` with them:
+// camera_depth_replay_plugin_test.cpp).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include "plugins/camera_rig/depth_camera.h"
 #include "support/host_poll.h"
 #include "support/instance_spec.h"
+#include "tests/plugins/cameras/wrist_shapes.h"
 
 namespace {
 
@@ -78,28 +80,6 @@ TEST_CASE(
 
 namespace {
 
-// The right (side 0) or left forearm's cylinder and capsule (role hand, config/robot/
-// crease_robot.urdf) placed so that the wrist camera mounted on the capsule looks straight down
-// from c_w (world mm): shapes[first], shapes[first + 1].
-void forearm_carrying(const crease::vision::Camera& cam, int side, const cv::Vec3d& c_w,
-                      crease::WorldShapes& out, std::uint32_t first) {
-  const cv::Matx33d R_wc(1, 0, 0, 0, -1, 0, 0, 0, -1);
-  const cv::Matx33d R_s = R_wc.t() * cam.R;
-  const cv::Vec3d p_s = c_w + R_s * (cam.R.t() * cam.t);
-  const cv::Vec3d centres[2] = {p_s + R_s * cv::Vec3d(0, 5, -105), p_s};
-  for (std::uint32_t k = 0; k < 2; ++k) {
-    crease::WorldShapes::Shape& s = out.shapes[first + k];
-    s.kind = k == 0 ? crease::WorldShapes::Kind::cylinder : crease::WorldShapes::Kind::capsule;
-    s.role = crease::WorldShapes::Role::hand;
-    s.side = static_cast<std::uint8_t>(side);
-    s.radius_mm = k == 0 ? 67.5f : 45.f;
-    s.half_length_mm = k == 0 ? 5.f : 55.f;
-    for (int i = 0; i < 3; ++i) s.position_mm[i] = static_cast<float>(centres[k][i]);
-    for (int i = 0; i < 9; ++i) s.rotation[i] = static_cast<float>(R_s.val[i]);
-  }
-  out.count = std::max(out.count, first + 2);
-}
-
 std::string configure_error(const std::string& yaml) {
   crease::PluginHost host({CREASE_PLUGIN_DIR});
   host.add_loop({"vision", 30.0, 0, -1});
@@ -150,8 +130,8 @@ TEST_CASE(
   const auto cams = crease::vision::load_depth_camera_dir(std::string(CREASE_SOURCE_DIR) +
                                                           "/config/wrist_cameras");
   auto shapes = std::make_unique<crease::WorldShapes>();
-  forearm_carrying(cams[0].camera, 0, {60, 0, 300}, *shapes, 0);
-  forearm_carrying(cams[1].camera, 1, {-60, 0, 300}, *shapes, 2);
+  wrist_shapes::forearm_carrying(cams[0].camera, 0, {60, 0, 300}, *shapes, 0);
+  wrist_shapes::forearm_carrying(cams[1].camera, 1, {-60, 0, 300}, *shapes, 2);
   std::int64_t stamp = 1;
   REQUIRE(crease::testing::poll_until(
       host,
@@ -174,10 +154,6 @@ TEST_CASE("camera_depth_sim wrist cameras: configuration errors name the file an
   CHECK(what.find(file) != std::string::npos);
   CHECK(what.find("wrist.params.world_shapes: must be true: cam0 is carried (right hand #1)") !=
         std::string::npos);
-  what = configure_error(
-      "{cameras: wrist_cameras, world_shapes: true, record: /tmp/crease_wrist_rec}");
-  CHECK(what.find("wrist.params.record: cam0 is carried (right hand #1): its pose per frame has no "
-                  "replay layout") != std::string::npos);
   what = configure_error("{cameras: wrist_cameras, world_shapes: true, sensor: d415}");
   CHECK(what.find("wrist.params.sensor: must be d435 or d405, not 'd415'") != std::string::npos);
   // A wrist camera naming a side that does not exist: its file and key.

@@ -2,14 +2,17 @@
 // `frame,timestamp_ns`, then `INDEX,STAMP` lines of integers, frame indices increasing, stamps
 // not decreasing. Anything else is a crease::ConfigError naming the file and the line, never a
 // stamp quietly read as something else (seconds `0.066667` read as 0 made every stamp 0).
-// A depth recording (16-bit depth and colour PNGs) reads back as the recorder wrote it.
+// A depth recording (16-bit depth and colour PNGs) reads back as the recorder wrote it; a carried
+// camera's pose per frame (camK/poses.csv) too, bit for bit, and a bad poses.csv names its line.
 #include "plugins/cameras/replay_reader.h"
 
 #include <doctest/doctest.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
@@ -131,6 +134,7 @@ TEST_CASE(
   const ReplayReader r(dir.string());
   REQUIRE(r.frames() == written.size());
   CHECK(r.depth_units_mm() == std::vector<double>{1.0, 0.1});
+  CHECK_FALSE(r.any_carried());  // no mount keys, no poses.csv: fixed cameras, as before poses
   REQUIRE(r.cameras().size() == 2);
   CHECK(r.cameras()[1].width == 64);
   CHECK(r.cameras()[1].height == 48);
@@ -140,6 +144,7 @@ TEST_CASE(
     r.read(i, f);
     CHECK(f.index == i);
     CHECK(f.timestamp_ns == written[i].timestamp_ns);
+    CHECK(f.poses.empty());  // every camera fixed: its calibration says where
     REQUIRE(f.images.size() == 4);
     for (std::size_t m = 0; m < 4; ++m) {
       CAPTURE(m);
@@ -162,4 +167,126 @@ TEST_CASE(
   CHECK(f.images[2].empty());
   CHECK_FALSE(f.images[1].empty());
   std::filesystem::remove_all(dir);
+}
+
+namespace {
+std::string poses_error_of(const std::string& text) {
+  try {
+    (void)parse_poses(text, "rec/cam1/poses.csv");
+  } catch (const crease::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool same_bits(const crease::frames::CameraPose& a, const crease::frames::CameraPose& b) {
+  return a.carried == b.carried && std::memcmp(a.rotation, b.rotation, sizeof a.rotation) == 0 &&
+         std::memcmp(a.translation_mm, b.translation_mm, sizeof a.translation_mm) == 0;
+}
+}  // namespace
+
+TEST_CASE(
+    "a carried camera's recording reads back its pose per frame bit for bit; the fixed one none") {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("crease_carried_replay_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const std::vector<Camera> cams = {look_at_camera("a", 64, 48, 60, {0, -60, 450}, {0, 0, 0}),
+                                    look_at_camera("b", 64, 48, 60, {0, 60, 450}, {0, 0, 0})};
+  const CameraMount wrist{0, crease::WorldShapes::Role::hand, 1};
+  cv::RNG rng(5);
+  std::vector<Frame> written(4);
+  {
+    Recorder rec(dir.string(), cams, {1.0, 0.1}, {std::nullopt, wrist});
+    for (std::size_t i = 0; i < written.size(); ++i) {
+      Frame& f = written[i];
+      f.index = 2 * i;  // indices need only increase
+      f.timestamp_ns = static_cast<std::int64_t>(i) * 33'333'333;
+      for (std::size_t k = 0; k < cams.size(); ++k) {
+        cv::Mat depth(48, 64, CV_16UC1), colour(48, 64, CV_8UC3);
+        rng.fill(depth, cv::RNG::UNIFORM, 0, 65536);
+        rng.fill(colour, cv::RNG::UNIFORM, 0, 256);
+        f.images.push_back(depth);
+        f.images.push_back(colour);
+      }
+      // Camera b where a turning arm put it: a rotation of full double precision, a centre with
+      // digits no short decimal holds.
+      cv::Matx33d R;
+      cv::Rodrigues(
+          cv::Vec3d(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)), R);
+      const cv::Vec3d t(rng.uniform(-500.0, 500.0) / 3, 1.0 / 3 + static_cast<double>(i), -0.0);
+      f.poses.assign(4, crease::frames::CameraPose{});
+      f.poses[2] = f.poses[3] = carried_pose(R, t);
+    }
+    written[1].images[2] = written[1].images[3] = cv::Mat();  // b not posed then: no images
+    written[1].poses[2] = written[1].poses[3] = crease::frames::CameraPose{};
+    for (const Frame& f : written) rec.write(f);
+  }
+  const ReplayReader r(dir.string());
+  REQUIRE(r.frames() == written.size());
+  CHECK(r.any_carried());
+  REQUIRE(r.mounts().size() == 2);
+  CHECK_FALSE(r.mounts()[0].has_value());
+  REQUIRE(r.mounts()[1].has_value());
+  CHECK(describe(*r.mounts()[1]) == "right hand #1");
+  int posed = 0;
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    CAPTURE(i);
+    Frame f;
+    r.read(i, f);
+    REQUIRE(f.poses.size() == 4);
+    CHECK_FALSE(f.poses[0].carried);  // the fixed camera
+    CHECK(same_bits(f.poses[2], written[i].poses[2]));
+    CHECK(same_bits(f.poses[3], written[i].poses[3]));
+    CHECK(f.images[2].empty() == written[i].images[2].empty());
+    posed += f.poses[2].carried ? 1 : 0;
+  }
+  CHECK(posed == 3);
+  // A pose line lost: that frame of camera b delivers nothing, never images without their pose.
+  {
+    std::ifstream in(replay_poses_path(dir.string(), 1));
+    std::string header, first;
+    std::getline(in, header);
+    std::getline(in, first);
+    std::ofstream(replay_poses_path(dir.string(), 1)) << header << "\n" << first << "\n";
+  }
+  const ReplayReader cut(dir.string());
+  Frame f;
+  cut.read(2, f);
+  CHECK(f.images[2].empty());
+  CHECK(f.images[3].empty());
+  CHECK_FALSE(f.images[0].empty());
+  CHECK_FALSE(f.poses[2].carried);
+  // The calibration names a mount but the pose file is gone: the recording does not open.
+  std::filesystem::remove(replay_poses_path(dir.string(), 1));
+  try {
+    const ReplayReader none(dir.string());
+    FAIL("opened");
+  } catch (const crease::ConfigError& e) {
+    CHECK(std::string(e.what()).find(replay_poses_path(dir.string(), 1) + ": cannot read") !=
+          std::string::npos);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("every other poses.csv is an error naming the file and the line") {
+  const std::string h = std::string(kReplayPosesHeader) + "\n";
+  const std::string id = ",1,0,0,0,1,0,0,0,1";
+  CHECK(poses_error_of(h + "0" + id + ",1,2,3\n3" + id + ",4,5,6\n").empty());
+  CHECK(poses_error_of("frame,pose\n").find("rec/cam1/poses.csv: line 1: the header must be") == 0);
+  CHECK(poses_error_of("").find("line 1: empty file") != std::string::npos);
+  CHECK(poses_error_of(h + "0" + id + ",1,2\n").find("line 2: expected twelve numbers") !=
+        std::string::npos);
+  CHECK(poses_error_of(h + "0" + id + ",1,2,3,4\n").find("line 2: expected twelve numbers") !=
+        std::string::npos);
+  CHECK(
+      poses_error_of(h + "0" + id + ",1,2,nan\n").find("line 2: number 12 'nan' is not a finite") !=
+      std::string::npos);
+  CHECK(poses_error_of(h + "0" + id + ",1,2,3mm\n").find("line 2: number 12 '3mm'") !=
+        std::string::npos);
+  CHECK(poses_error_of(h + "0" + id + ",1,,3\n").find("line 2: number 11 ''") != std::string::npos);
+  CHECK(poses_error_of(h + "-1" + id + ",1,2,3\n").find("line 2: expected 'FRAME,'") !=
+        std::string::npos);
+  CHECK(poses_error_of(h + "4" + id + ",1,2,3\n4" + id + ",1,2,3\n")
+            .find("line 3: frame 4 after frame 4: frame indices must increase") !=
+        std::string::npos);
 }

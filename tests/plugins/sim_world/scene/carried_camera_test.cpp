@@ -17,50 +17,14 @@
 #include "plugins/sim_world/robot_shapes.h"
 #include "plugins/sim_world/scene/depth_sim_source.h"
 #include "tests/plugins/sim_world/scene.h"
+#include "tests/plugins/sim_world/scene/forearm_rig.h"
 
 using namespace crease::vision;
-using Role = crease::WorldShapes::Role;
+using namespace forearm_rig;  // Role, looking_down, shape, set_pose, forearm_carrying, d405
 
 namespace {
 const std::string kSrc = CREASE_SOURCE_DIR;
 constexpr double kSheetZ = 0.5;  // a flat sheet's surface, world mm (half its 1 mm thickness)
-
-// Looking straight down (image x along the world's x), then turned by tilt_deg about its own x.
-cv::Matx33d looking_down(double tilt_deg) {
-  const double a = tilt_deg * CV_PI / 180, c = std::cos(a), s = std::sin(a);
-  return cv::Matx33d(1, 0, 0, 0, c, -s, 0, s, c) * cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1);
-}
-
-SceneShape shape(crease::world::GeomKind kind, double radius, double half_length, Role role,
-                 int side) {
-  SceneShape s;
-  s.geom.kind = kind;
-  s.geom.radius_mm = radius;
-  s.geom.half_length_mm = half_length;
-  s.role = role;
-  s.side = static_cast<std::uint8_t>(side);
-  return s;
-}
-
-void set_pose(SceneShape& s, const cv::Matx33d& R, const cv::Vec3d& p) {
-  for (int k = 0; k < 9; ++k) s.pose.r[k] = R.val[k];
-  s.pose.t = {p[0], p[1], p[2]};
-}
-
-// The right forearm as the world publishes it (config/robot/crease_robot.urdf: its cylinder, then
-// its capsule, role hand) placed so that CAM, mounted on the capsule (hand #1), is at the world
-// pose R_wc (world -> camera) with its centre at c_w.
-std::vector<SceneShape> forearm_carrying(const Camera& cam, const cv::Matx33d& R_wc,
-                                         const cv::Vec3d& c_w) {
-  const cv::Matx33d R_s = R_wc.t() * cam.R;    // the capsule's axes: cam.R * R_s^T = R_wc
-  const cv::Vec3d c_s = -(cam.R.t() * cam.t);  // the camera's centre in the capsule's frame
-  const cv::Vec3d p_s = c_w - R_s * c_s;
-  SceneShape disc = shape(crease::world::GeomKind::cylinder, 67.5, 5, Role::hand, 0);
-  SceneShape capsule = shape(crease::world::GeomKind::capsule, 45, 55, Role::hand, 0);
-  set_pose(capsule, R_s, p_s);
-  set_pose(disc, R_s, p_s + R_s * cv::Vec3d(0, 5, -105));  // the forearm's origin side
-  return {disc, capsule};
-}
 
 struct PlaneFit {
   int points = 0;
@@ -95,13 +59,6 @@ PlaneFit plane_fit(const DepthCamera& cam, const cv::Mat& depth, const cv::Mat& 
   return f;
 }
 
-DepthSensorModel d405() {
-  DepthSensorModel sm;  // camera_depth_sim's `sensor: d405`
-  sm.baseline_mm = 18;
-  sm.min_range_mm = 70;
-  sm.max_range_mm = 500;
-  return sm;
-}
 }  // namespace
 
 TEST_CASE("mount_shape_index: the index-th shape of that role on that side, in the port's order") {
