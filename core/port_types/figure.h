@@ -32,6 +32,15 @@ struct Figure {
     return f;
   }
 
+  // A share of events, in %: EVENTS so far, HITS of them (late frames, dropped views); the newest
+  // sample is 100 when HITS grew since the last call (PREV_HITS), else 0. RT.
+  void set_share(std::uint64_t events, std::uint64_t hits, std::uint64_t prev_hits) noexcept {
+    count = events;
+    sum = 100.0 * static_cast<double>(hits);
+    last = hits != prev_hits ? 100.0 : 0.0;
+    max = hits > 0 ? 100.0 : 0.0;
+  }
+
   [[nodiscard]] bool all_finite() const { return std::isfinite(sum) && std::isfinite(last) && std::isfinite(max); }
   [[nodiscard]] double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }
 };

@@ -137,10 +137,7 @@ class CameraDepthSimPlugin final : public CameraPlugin {
   void report_carried_rt(std::int64_t now_ns) noexcept {
     const std::uint64_t frames = source_->carried_frames(), unposed = source_->carried_unposed();
     if (frames == seen_frames_) return;
-    unposed_.count = frames;
-    unposed_.sum = 100.0 * static_cast<double>(unposed);
-    unposed_.last = unposed != seen_unposed_ ? 100.0 : 0.0;
-    unposed_.max = unposed > 0 ? 100.0 : 0.0;
+    unposed_.set_share(frames, unposed, seen_unposed_);
     unposed_out_.write(unposed_, now_ns);
     seen_frames_ = frames;
     seen_unposed_ = unposed;

@@ -65,10 +65,7 @@ class CameraReplayPlugin final : public CameraPlugin {
       lag_.sum += n * lag_ms;
       lag_.last = lag_ms;
       lag_.max = static_cast<double>(source_->max_lag_ns()) * 1e-6;
-      late_.count = played;
-      late_.sum = 100.0 * static_cast<double>(late);
-      late_.last = newest_late ? 100.0 : 0.0;
-      late_.max = late > 0 ? 100.0 : 0.0;
+      late_.set_share(played, late, seen_late_);
       lag_out_.write(lag_, cycle.time_ns);
       late_out_.write(late_, cycle.time_ns);
       if (newest_late && !behind_)

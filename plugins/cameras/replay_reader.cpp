@@ -33,10 +33,12 @@ bool parse_uint(const std::string& s, std::size_t begin, std::size_t end, std::u
   return true;
 }
 
-}  // namespace
-
-std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::string& file) {
-  std::vector<RecordedStamp> out;
+// Calls ROW(line, fail) for each non-empty line after the header of the CSV file FILE (its
+// TEXT), whose first line must be HEADER exactly (NOTE: what the reader adds to the message);
+// FAIL(why) throws a ConfigError naming the file and the line.
+template <class Row>
+void for_each_row(const std::string& text, const std::string& file, const std::string& header,
+                  const char* note, Row&& row) {
   std::istringstream in(text);
   std::string line;
   int lineno = 0;
@@ -47,53 +49,51 @@ std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::
     ++lineno;
     if (!line.empty() && line.back() == '\r') line.pop_back();  // a file written on Windows
     if (lineno == 1) {
-      if (line != "frame,timestamp_ns")
-        fail("the header must be exactly 'frame,timestamp_ns' (integer nanoseconds), not '" + line + "'");
+      if (line != header)
+        fail("the header must be exactly '" + header + "'" + note + ", not '" + line + "'");
       continue;
     }
-    if (line.empty()) continue;
-    const std::size_t comma = line.find(',');
-    std::uint64_t frame = 0, stamp = 0;
-    if (comma == std::string::npos || !parse_uint(line, 0, comma, frame))
-      fail("expected 'FRAME,TIMESTAMP_NS' with a non-negative integer frame index, not '" + line + "'");
-    if (!parse_uint(line, comma + 1, line.size(), stamp) ||
-        stamp > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
-      fail("the timestamp must be a non-negative integer of nanoseconds with nothing after it, not '" +
-           line.substr(comma + 1) + "'");
-    const auto t = static_cast<std::int64_t>(stamp);
-    if (!out.empty() && frame <= out.back().frame)
-      fail("frame " + std::to_string(frame) + " after frame " + std::to_string(out.back().frame) +
-           ": frame indices must increase");
-    if (!out.empty() && t < out.back().stamp_ns)
-      fail("timestamp " + std::to_string(t) + " ns before the previous frame's " +
-           std::to_string(out.back().stamp_ns) + " ns: stamps must not decrease");
-    out.push_back({frame, t});
+    if (!line.empty()) row(line, fail);
   }
   if (lineno == 0) {
     lineno = 1;
-    fail("empty file: expected the header 'frame,timestamp_ns'");
+    fail("empty file: expected the header '" + header + "'");
   }
+}
+
+}  // namespace
+
+std::vector<RecordedStamp> parse_timestamps(const std::string& text, const std::string& file) {
+  std::vector<RecordedStamp> out;
+  for_each_row(
+      text, file, "frame,timestamp_ns", " (integer nanoseconds)",
+      [&](const std::string& line, auto& fail) {
+        const std::size_t comma = line.find(',');
+        std::uint64_t frame = 0, stamp = 0;
+        if (comma == std::string::npos || !parse_uint(line, 0, comma, frame))
+          fail("expected 'FRAME,TIMESTAMP_NS' with a non-negative integer frame index, not '" +
+               line + "'");
+        if (!parse_uint(line, comma + 1, line.size(), stamp) ||
+            stamp > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+          fail(
+              "the timestamp must be a non-negative integer of nanoseconds with nothing after it, "
+              "not '" +
+              line.substr(comma + 1) + "'");
+        const auto t = static_cast<std::int64_t>(stamp);
+        if (!out.empty() && frame <= out.back().frame)
+          fail("frame " + std::to_string(frame) + " after frame " +
+               std::to_string(out.back().frame) + ": frame indices must increase");
+        if (!out.empty() && t < out.back().stamp_ns)
+          fail("timestamp " + std::to_string(t) + " ns before the previous frame's " +
+               std::to_string(out.back().stamp_ns) + " ns: stamps must not decrease");
+        out.push_back({frame, t});
+      });
   return out;
 }
 
 std::vector<RecordedPose> parse_poses(const std::string& text, const std::string& file) {
   std::vector<RecordedPose> out;
-  std::istringstream in(text);
-  std::string line;
-  int lineno = 0;
-  auto fail = [&](const std::string& why) {
-    throw crease::ConfigError(file + ": line " + std::to_string(lineno) + ": " + why);
-  };
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (lineno == 1) {
-      if (line != kReplayPosesHeader)
-        fail(std::string("the header must be exactly '") + kReplayPosesHeader + "', not '" + line +
-             "'");
-      continue;
-    }
-    if (line.empty()) continue;
+  for_each_row(text, file, kReplayPosesHeader, "", [&](const std::string& line, auto& fail) {
     RecordedPose r;
     r.pose.carried = true;
     std::size_t comma = line.find(',');
@@ -120,11 +120,7 @@ std::vector<RecordedPose> parse_poses(const std::string& text, const std::string
       fail("frame " + std::to_string(r.frame) + " after frame " + std::to_string(out.back().frame) +
            ": frame indices must increase");
     out.push_back(r);
-  }
-  if (lineno == 0) {
-    lineno = 1;
-    fail(std::string("empty file: expected the header '") + kReplayPosesHeader + "'");
-  }
+  });
   return out;
 }
 

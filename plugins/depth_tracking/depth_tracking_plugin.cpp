@@ -80,10 +80,7 @@ class DepthTrackingPlugin final : public Plugin {
   void report_bad_pose_rt(std::int64_t now_ns) noexcept {
     const std::uint64_t bad = worker_->bad_pose_views(), views = worker_->views();
     if (views == seen_views_) return;
-    bad_pose_.count = views;
-    bad_pose_.sum = 100.0 * static_cast<double>(bad);
-    bad_pose_.last = bad != seen_bad_ ? 100.0 : 0.0;
-    bad_pose_.max = bad > 0 ? 100.0 : 0.0;
+    bad_pose_.set_share(views, bad, seen_bad_);
     bad_pose_out_.write(bad_pose_, now_ns);
     seen_views_ = views;
     seen_bad_ = bad;

@@ -73,6 +73,7 @@ WorldPluginConfig read_world_config(const Params& p) {
   g.origin_mm.x = p.get_in_range<double>("origin_x_mm", g.origin_mm.x, -1000.0, 1000.0);
   g.origin_mm.y = p.get_in_range<double>("origin_y_mm", g.origin_mm.y, -1000.0, 1000.0);
   g.turn_deg = p.get_in_range<double>("sheet_turn_deg", g.turn_deg, -180.0, 180.0);
+  w.sheet.solver.substeps = p.get_in_range<int>("substeps", w.sheet.solver.substeps, 1, 16);
   w.table_height_mm = p.get_in_range<double>("table_height_mm", w.table_height_mm, -500.0, 500.0);
   read_table_extent(p, w.table_extent_mm);
   w.initial_stiffness_nm_per_rad =

@@ -64,6 +64,19 @@ TEST_CASE("sheet_turn_deg turns the world's sheet grid; out of range it names fi
   CHECK(e.find("sheet_turn_deg") != std::string::npos);
 }
 
+TEST_CASE(
+    "substeps: the sheet's 2 by default, as given within 1-16; out of range it names file, line "
+    "and key") {
+  CHECK(read("").world.sheet.solver.substeps == 2);
+  CHECK(read("substeps: 4\n").world.sheet.solver.substeps == 4);
+  for (const char* bad : {"substeps: 0\n", "substeps: 17\n", "substeps: two\n"}) {
+    const std::string e = error_of(bad);
+    INFO(bad << " -> " << e);
+    CHECK(e.find("sim.yaml:2") != std::string::npos);
+    CHECK(e.find("substeps") != std::string::npos);
+  }
+}
+
 // The devices' command watchdog: a real device's 20 ms unless the configuration says
 // (config/sim.yaml: 100, as the drivers' tolerance of the shared machine's stalls); the simulated
 // robot takes it.
