@@ -353,6 +353,7 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       // is not this fold's fault: only new ones count.
       for (int s2 = 0; s2 < 2; ++s2) m_.inhibits0[s2] = in.hand[s2] != nullptr ? in.hand[s2]->inhibits : 0;
       m_.via = 0;
+      m_.slides = 0;
       m_.vision_bad_since_ns = 0;
       m_.frame_held = 0;
       m_.abort_reason = Reason::none;
@@ -365,11 +366,18 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::shift_contact: descend(kFixing, f.shift, out); break;
     case S::shift_press: hand_force(kFixing, f.shift.fingers, f.shift.force_n, in, out); break;
     case S::shift_slide: {
-      double d[2] = {0, 0};
-      const double len = slide_length(in, d);
-      if (!std::isfinite(len)) d[0] = d[1] = 0;  // the guard saw a sheet; a stale one here moves nothing
-      const double p[3] = {f.shift.at_mm[0] + d[0], f.shift.at_mm[1] + d[1], -f.slide_height_mm};
-      arm_move(kFixing, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+      double d[2] = {0, 0}, w[2] = {0, 0};
+      const double len = slide_length(in, d, w);
+      if (!std::isfinite(len))
+        d[0] = d[1] = w[0] = w[1] = 0;  // the guard saw a sheet; a stale one here moves nothing
+      if (m_.slides++ == 0) {           // from the press point, in the sheet's frame
+        const double p[3] = {f.shift.at_mm[0] + d[0], f.shift.at_mm[1] + d[1], -f.slide_height_mm};
+        arm_move(kFixing, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+      } else {  // the rest, from where the finger is (it slipped over the sheet): the corner's way
+                // in the world
+        const double p[3] = {w[0], w[1], 0.0}, keep[4] = {0, 0, 0, 1};
+        arm_move(kFixing, f.shift.tool, ArmGoal::measured, p, keep, f.slide, 0, out);
+      }
       break;
     }
     case S::grasp_fixate: hand_force(kFixing, f.shift.fingers, f.fixate_force_n, in, out); break;

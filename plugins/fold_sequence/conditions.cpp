@@ -121,6 +121,10 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
       return true;
     }
     case Ev::crease_acked: return in.sheet != nullptr && in.sheet->crease_count > m_.crease_count0;
+    case Ev::sheet_settled:
+      return in.sheet != nullptr &&
+             in.sheet->timestamp_ns >=
+                 m_.leaf_since_ns + static_cast<std::int64_t>(spec_.shift_settle_s * 1e9);
     case Ev::memorized: return in.sheet != nullptr && in.sheet->step >= m_.sheet_step0 + 2;
     case Ev::stopped:
       for (int s = 0; s < 2; ++s) {
@@ -144,7 +148,8 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
   return false;
 }
 
-double Machine::slide_length(const Sensing& in, double d_sheet[2]) const noexcept {
+double Machine::slide_length(const Sensing& in, double d_sheet[2],
+                             double d_world[2]) const noexcept {
   SheetFrame f;
   double corner[3];
   if (in.sheet == nullptr || !sheet_frame(*in.sheet, f) || !node_at(*in.sheet, spec_.corner_mm[0], spec_.corner_mm[1], corner))
@@ -153,6 +158,10 @@ double Machine::slide_length(const Sensing& in, double d_sheet[2]) const noexcep
   const double d[3] = {spec_.corner_target_mm[0] - corner[0], spec_.corner_target_mm[1] - corner[1], 0.0};
   d_sheet[0] = d[0] * f.x[0] + d[1] * f.x[1] + d[2] * f.x[2];
   d_sheet[1] = d[0] * f.y[0] + d[1] * f.y[1] + d[2] * f.y[2];
+  if (d_world != nullptr) {
+    d_world[0] = d[0];
+    d_world[1] = d[1];
+  }
   return std::hypot(d[0], d[1]);
 }
 
@@ -182,6 +191,11 @@ bool Machine::passes(Guard g, const Sensing& in) const noexcept {
     }
     case Guard::slide_short: return slide_length(in, d) <= spec_.shift_tolerance_mm;
     case Guard::slide_too_long: return slide_length(in, d) > spec_.max_slide_mm;
+    case Guard::slide_again: {
+      const double l = slide_length(in, d);
+      return l > spec_.shift_tolerance_mm && l <= spec_.max_slide_mm &&
+             m_.slides < spec_.max_slides;
+    }
     case Guard::fixing_armed:
     case Guard::pinching_armed: {
       const ContactState* c = in.contact[g == Guard::fixing_armed ? kFixing : kPinching];

@@ -219,6 +219,8 @@ void read(const Params& p, FoldSpec& f) {
   numbers(a, "corner_target_mm", 2, f.corner_target_mm);
   f.shift_tolerance_mm = a.get_in_range<double>("tolerance_mm", 3.0, 0.0, 100.0);
   f.max_slide_mm = a.get_in_range<double>("max_slide_mm", 150.0, 0.0, 1000.0);
+  f.max_slides = a.get_in_range<int>("max_slides", 4, 1, 20);
+  f.shift_settle_s = a.get_in_range<double>("settle_s", 0.3, 0.0, 10.0);
   f.slide_height_mm = a.get_in_range<double>("slide_height_mm", 0.0, -20.0, 50.0);
 
   const Params b = p.child("grasp");

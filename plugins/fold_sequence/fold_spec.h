@@ -89,6 +89,11 @@ struct FoldSpec {
   double corner_target_mm[2] = {0, 0};
   double shift_tolerance_mm = 3;   // no slide when the corner is this close already
   double max_slide_mm = 150;       // a longer slide aborts (reason slide_out_of_range)
+  // After each slide the tracked sheet, settle_s after the arm arrived, says whether the corner is
+  // within the tolerance; short of it (the finger slipped over the sheet) the rest is slid from
+  // where the finger is, up to max_slides slides in all (then abort: shift_short).
+  int max_slides = 4;
+  double shift_settle_s = 0.3;
   double slide_height_mm = 0;      // the tool frame's height above the sheet while sliding
 
   // (b) grasp: the fixing hand fixates with fixate_force_n; the pinching one takes prepinch_rad while its

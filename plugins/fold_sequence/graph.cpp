@@ -28,6 +28,8 @@ const char* event_name(Ev e) {
     case Ev::hands_posed: return "hands posed";
     case Ev::pinched: return "pinched";
     case Ev::crease_acked: return "crease in model";
+    case Ev::sheet_settled:
+      return "sheet settled";
     case Ev::memorized: return "model memorized";
     case Ev::stopped: return "stopped";
     case Ev::arms_done: return "arms done";
@@ -43,6 +45,8 @@ const char* guard_name(Guard g) {
     case Guard::slide_needed: return "slide needed";
     case Guard::slide_short: return "corner in reach";
     case Guard::slide_too_long: return "slide too long";
+    case Guard::slide_again:
+      return "corner short, slides left";
     case Guard::fixing_armed: return "fixing contact armed";
     case Guard::pinching_armed: return "pinching contact armed";
     case Guard::more_via: return "more via";

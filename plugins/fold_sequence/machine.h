@@ -96,13 +96,14 @@ struct Memory {
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
   // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
   // park in joint space, halved while out of reach); 6: aborted_from; 7: pinch_off_since_ns;
-  // 8: held_frame
-  static constexpr std::uint32_t kVersion = 8;
+  // 8: held_frame; 9: shift/check, slides
+  static constexpr std::uint32_t kVersion = 9;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
   S leaf = S::idle;
   std::uint8_t via = 0;
+  std::uint8_t slides = 0;          // the shift's slides so far
   std::uint8_t paused = 0;          // by the operator (arms stopped): resume re-enters the leaf
   std::uint8_t step_mode = 0;
   std::uint8_t start_pending = 0;
@@ -193,7 +194,8 @@ class Machine {
   // states, or not judged (JUDGED false: a model state from within the state's first 150 ms,
   // which may lag the state's motion; the time off the way runs on through it).
   [[nodiscard]] Reason grasp_off(const SheetState& sh, bool& judged) const noexcept;
-  [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2]) const noexcept;
+  [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2],
+                                    double d_world[2] = nullptr) const noexcept;
   // actions.cpp: entry and exit actions, the goals.
   void enter(S s, const Sensing& in, Outbox& out) noexcept;
   void exit(S s, const Sensing& in, Outbox& out) noexcept;

@@ -23,16 +23,58 @@ enum class S : std::uint8_t {
   root,
   idle,
   fold,
-  shift, shift_approach, shift_contact, shift_press, shift_slide,
-  grasp, grasp_fixate, grasp_shape, grasp_above, grasp_reach, grasp_pinch,
-  bend, bend_crease, follow_via,
-  fixate_layer, layer_lay,
-  refixate, refix_slide_out, refix_open, refix_lift, refix_approach, refix_contact, refix_press,
-  swipe, swipe_release, swipe_withdraw, swipe_open, swipe_lift, swipe_approach, swipe_contact, swipe_press, swipe_slide,
-  harden, harden_open, harden_lift, harden_approach, harden_contact, harden_press, harden_slide,
-  finish, finish_memorize, finish_open, finish_lift, finish_park,
+  shift,
+  shift_approach,
+  shift_contact,
+  shift_press,
+  shift_slide,
+  shift_check,
+  grasp,
+  grasp_fixate,
+  grasp_shape,
+  grasp_above,
+  grasp_reach,
+  grasp_pinch,
+  bend,
+  bend_crease,
+  follow_via,
+  fixate_layer,
+  layer_lay,
+  refixate,
+  refix_slide_out,
+  refix_open,
+  refix_lift,
+  refix_approach,
+  refix_contact,
+  refix_press,
+  swipe,
+  swipe_release,
+  swipe_withdraw,
+  swipe_open,
+  swipe_lift,
+  swipe_approach,
+  swipe_contact,
+  swipe_press,
+  swipe_slide,
+  harden,
+  harden_open,
+  harden_lift,
+  harden_approach,
+  harden_contact,
+  harden_press,
+  harden_slide,
+  finish,
+  finish_memorize,
+  finish_open,
+  finish_lift,
+  finish_park,
   done,
-  abort, abort_stop, abort_open, abort_lift, abort_reopen, abort_park,
+  abort,
+  abort_stop,
+  abort_open,
+  abort_lift,
+  abort_reopen,
+  abort_park,
   aborted,
   count
 };
@@ -41,16 +83,25 @@ static_assert(kStateCount <= kStates, "FoldSpec keeps one timeout per state");
 
 // What makes a row fire: a condition of the sensing against what the state commanded.
 enum class Ev : std::uint8_t {
-  start,          // the operator's start
-  timeout,        // the row's state has been in it longer than its timeout
-  fault,          // a fault of the sensing (Reason says which); fold's rows only
-  arm_fix_reached, arm_pin_reached, arms_reached,   // the state's arm goal(s) reached
-  arm_fix_contact, arm_pin_contact,                 // stopped on a contact onset
-  arm_fix_missed, arm_pin_missed,                   // a contact descent reached its depth untouched
-  hand_fix_settled, hand_pin_settled,               // force settled on the state's force goal
-  hand_fix_posed, hand_pin_posed, hands_posed,      // the state's posture goal done
+  start,    // the operator's start
+  timeout,  // the row's state has been in it longer than its timeout
+  fault,    // a fault of the sensing (Reason says which); fold's rows only
+  arm_fix_reached,
+  arm_pin_reached,
+  arms_reached,  // the state's arm goal(s) reached
+  arm_fix_contact,
+  arm_pin_contact,  // stopped on a contact onset
+  arm_fix_missed,
+  arm_pin_missed,  // a contact descent reached its depth untouched
+  hand_fix_settled,
+  hand_pin_settled,  // force settled on the state's force goal
+  hand_fix_posed,
+  hand_pin_posed,
+  hands_posed,    // the state's posture goal done
   pinched,        // the pinching hand's closing ended with the pinch fingers squeezing (force_n)
   crease_acked,   // sheet_state carries one crease more than when the state began
+  sheet_settled,  // a sheet_state taken settle_s or more after the state began (the model caught
+                  // up)
   memorized,      // a sheet_state newer than the memorize request (the model consumed it)
   stopped,        // abort: both hands took the hold goal (or retreat on their own, or refused
                   // it), and neither arm runs a motion
@@ -61,13 +112,15 @@ enum class Ev : std::uint8_t {
 
 enum class Guard : std::uint8_t {
   none,
-  ready,          // start: every controller answers (fresh; contact healthy; the hand commanded), the sheet is seen
-  slide_needed,   // shift: the corner is further than the tolerance from its target
-  slide_short,    // shift: not needed (already there)
-  slide_too_long, // shift: longer than max_slide_mm
-  fixing_armed,   // the hand's contact_state is armed, healthy: a contact motion may start
+  ready,  // start: every controller answers (fresh; contact healthy; the hand commanded), the sheet
+          // is seen
+  slide_needed,    // shift: the corner is further than the tolerance from its target
+  slide_short,     // shift: not needed (already there)
+  slide_too_long,  // shift: longer than max_slide_mm
+  slide_again,     // shift: slide_needed, and fewer than max_slides slides so far
+  fixing_armed,    // the hand's contact_state is armed, healthy: a contact motion may start
   pinching_armed,
-  more_via,       // bend: via points left
+  more_via,  // bend: via points left
   last_via,
 };
 
@@ -87,9 +140,11 @@ enum class Reason : std::uint8_t {
   no_sheet,      // a state needed the sheet's pose and there was none
   command_lost,  // a command queue was full
   operator_abort,
-  no_contact,  // a contact descent reached its depth (below the surface) without a contact
-  pinch_lost,  // the tracked grasp point left the pinching tool's way (bend, lay)
-  fold_lost,   // ... or, the pinch let go, left where the layer was laid (swipe, harden)
+  no_contact,   // a contact descent reached its depth (below the surface) without a contact
+  pinch_lost,   // the tracked grasp point left the pinching tool's way (bend, lay)
+  fold_lost,    // ... or, the pinch let go, left where the layer was laid (swipe, harden)
+  shift_short,  // the corner still off its target after max_slides slides (the finger slipping over
+                // the sheet)
   count
 };
 [[nodiscard]] const char* reason_name(Reason r) noexcept;

@@ -124,6 +124,7 @@ class World {
   void measure_penetration_rt() noexcept;
   [[nodiscard]] bool over_table(Vec3 p) const noexcept;  // within the table top's extent in x, y
   void fill_state_rt() noexcept;
+  void add_table_slab();  // configure time: the sheet's table with edges
 
   WorldParams params_;
   WorldDraws draws_;

@@ -76,6 +76,8 @@ WorldPluginConfig read_world_config(const Params& p) {
   w.sheet.solver.substeps = p.get_in_range<int>("substeps", w.sheet.solver.substeps, 1, 16);
   w.table_height_mm = p.get_in_range<double>("table_height_mm", w.table_height_mm, -500.0, 500.0);
   read_table_extent(p, w.table_extent_mm);
+  w.table_edge_radius_mm =
+      p.get_in_range<double>("table_edge_radius_mm", w.table_edge_radius_mm, 0.0, 20.0);
   w.initial_stiffness_nm_per_rad =
       p.get_in_range<double>("initial_stiffness_nm_per_rad", w.initial_stiffness_nm_per_rad, 0.0, 1000.0);
   const double zero_hand[robot::kHandJoints] = {};

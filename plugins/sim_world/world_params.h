@@ -42,6 +42,9 @@ struct WorldParams {
   // Finite, the sheet can hang over an edge (a corner to pinch from above and below).
   std::array<double, 4> table_extent_mm = {-kNoEdge, kNoEdge, -kNoEdge, kNoEdge};
   static constexpr double kNoEdge = 1e9;
+  // The radius its edges are rounded to, for the sheet (mm; 0: square). Paper pulled back over a
+  // square edge stuck on its side face.
+  double table_edge_radius_mm = 5.0;
 
   // Contact stiffness of a surface pressed onto paper or the table: N per mm of compression
   // per mm^2 of contact (a cover of Young's modulus E and thickness t: E / t). A sheet node

@@ -107,7 +107,8 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
   std::string path = path_of(status.value()), deepest = path;
   double lowest_mm = start.fixing_ff_z_mm, press_force_n = 0;
   const auto deeper = [](const std::string& p) {
-    return p == "fold/shift/press" || p == "fold/shift/slide" || p.rfind("fold/grasp", 0) == 0;
+    return p == "fold/shift/press" || p == "fold/shift/slide" || p == "fold/shift/check" ||
+           p.rfind("fold/grasp", 0) == 0;
   };
   const int limit_ms = wired ? 40000 : 5000;
   for (int i = 0; i < limit_ms; ++i) {

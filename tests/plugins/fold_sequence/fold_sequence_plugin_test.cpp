@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -21,22 +22,52 @@ using crease::fold::Command;
 
 namespace {
 
-const std::vector<std::string> kHalfPath = {
-    "idle",
-    "fold/shift/approach", "fold/shift/contact", "fold/shift/press", "fold/shift/slide",
-    "fold/grasp/fixate", "fold/grasp/shape", "fold/grasp/above", "fold/grasp/reach", "fold/grasp/pinch",
-    "fold/bend/crease", "fold/bend/follow_via[0]", "fold/bend/follow_via[1]", "fold/bend/follow_via[2]",
-    "fold/bend/follow_via[3]", "fold/bend/follow_via[4]", "fold/bend/follow_via[5]", "fold/bend/follow_via[6]",
-    "fold/bend/follow_via[7]",
-    "fold/fixate_layer/lay",
-    "fold/refixate/slide_out", "fold/refixate/open", "fold/refixate/lift", "fold/refixate/approach",
-    "fold/refixate/contact", "fold/refixate/press",
-    "fold/swipe/release", "fold/swipe/withdraw", "fold/swipe/open", "fold/swipe/lift", "fold/swipe/approach",
-    "fold/swipe/contact", "fold/swipe/press", "fold/swipe/slide",
-    "fold/harden/open", "fold/harden/lift", "fold/harden/approach", "fold/harden/contact", "fold/harden/press",
-    "fold/harden/slide",
-    "fold/finish/memorize", "fold/finish/open", "fold/finish/lift", "fold/finish/park",
-    "done"};
+const std::vector<std::string> kHalfPath = {"idle",
+                                            "fold/shift/approach",
+                                            "fold/shift/contact",
+                                            "fold/shift/press",
+                                            "fold/shift/slide",
+                                            "fold/shift/check",
+                                            "fold/grasp/fixate",
+                                            "fold/grasp/shape",
+                                            "fold/grasp/above",
+                                            "fold/grasp/reach",
+                                            "fold/grasp/pinch",
+                                            "fold/bend/crease",
+                                            "fold/bend/follow_via[0]",
+                                            "fold/bend/follow_via[1]",
+                                            "fold/bend/follow_via[2]",
+                                            "fold/bend/follow_via[3]",
+                                            "fold/bend/follow_via[4]",
+                                            "fold/bend/follow_via[5]",
+                                            "fold/bend/follow_via[6]",
+                                            "fold/bend/follow_via[7]",
+                                            "fold/fixate_layer/lay",
+                                            "fold/refixate/slide_out",
+                                            "fold/refixate/open",
+                                            "fold/refixate/lift",
+                                            "fold/refixate/approach",
+                                            "fold/refixate/contact",
+                                            "fold/refixate/press",
+                                            "fold/swipe/release",
+                                            "fold/swipe/withdraw",
+                                            "fold/swipe/open",
+                                            "fold/swipe/lift",
+                                            "fold/swipe/approach",
+                                            "fold/swipe/contact",
+                                            "fold/swipe/press",
+                                            "fold/swipe/slide",
+                                            "fold/harden/open",
+                                            "fold/harden/lift",
+                                            "fold/harden/approach",
+                                            "fold/harden/contact",
+                                            "fold/harden/press",
+                                            "fold/harden/slide",
+                                            "fold/finish/memorize",
+                                            "fold/finish/open",
+                                            "fold/finish/lift",
+                                            "fold/finish/park",
+                                            "done"};
 
 // The half fold's roles (config/folds/half.yaml): the left hand shifts and fixates, the right pinches.
 constexpr int kFix = kLeft;
@@ -774,6 +805,50 @@ TEST_CASE("the shift's guard: a corner already in reach skips the slide") {
   CHECK(std::string(r.status().why) == "corner already in reach");
 }
 
+// The tracked corner (105, 297) of the rig's 3 x 3 sheet, world x, y.
+std::array<double, 2> corner_xy(const Rig& r) {
+  const float* p = r.sheet().position_mm[7];
+  return {p[0], p[1]};
+}
+
+TEST_CASE(
+    "the shift is judged by the tracked sheet: a finger slipping half the way slides on from where "
+    "it is") {
+  Rig r;
+  r.shift_drag = 0.5;  // the sheet follows the pressed finger half the way
+  r.command(Command::start);
+  REQUIRE(r.run_to("fold/grasp/fixate"));
+  const auto slides = std::count(r.paths().begin(), r.paths().end(), "fold/shift/slide");
+  const auto checks = std::count(r.paths().begin(), r.paths().end(), "fold/shift/check");
+  MESSAGE(slides << " slides; the corner ends at " << corner_xy(r)[0] << ", " << corner_xy(r)[1]);
+  CHECK(slides >= 2);
+  CHECK(slides <= 4);
+  CHECK(checks == slides);
+  CHECK(std::hypot(corner_xy(r)[0] - 0.0, corner_xy(r)[1] - 148.5) <= 3.0);  // shift.tolerance_mm
+  CHECK(std::string(r.status().why) == "sheet shifted");
+  // The first slide in the sheet's frame from the press point, the others from where the tool is.
+  std::vector<const Sent*> moves;
+  for (const Sent* x : r.all(kFix, Sent::arm))
+    if (x->arm_goal.kind == ArmGoal::move) moves.push_back(x);
+  REQUIRE(moves.size() >= 4);  // approach, descent, the slides
+  CHECK(moves[2]->arm_goal.frame == ArmGoal::sheet);
+  for (std::size_t k = 3; k < moves.size(); ++k) {
+    CHECK(moves[k]->arm_goal.frame == ArmGoal::measured);
+    CHECK(moves[k]->arm_goal.position_mm[0][2] == 0.0);  // along the table
+  }
+  REQUIRE(r.run_to("done"));
+
+  // Failing variant, the arm's arrival taken for the sheet's: with the finger dragging nothing the
+  // corner never comes; max_slides slides, then the abort, the hands open.
+  Rig stuck;
+  stuck.shift_drag = 0.0;
+  stuck.command(Command::start);
+  expect_abort(stuck, crease::fold::Reason::shift_short);
+  CHECK(std::count(stuck.paths().begin(), stuck.paths().end(), "fold/shift/slide") == 4);
+  CHECK(std::find(stuck.paths().begin(), stuck.paths().end(), "fold/grasp/fixate") ==
+        stuck.paths().end());
+}
+
 TEST_CASE("pause stops the arms and holds; resume sends the state's goal again; time in state stops") {
   Rig r;
   start_and_run_to(r, "fold/bend/follow_via[1]");
@@ -813,9 +888,10 @@ TEST_CASE("step mode: one transition per step") {
   CHECK(std::string(r.status().path) == "fold/shift/approach");
   CHECK(r.status().phase == SequenceStatus::paused);
   CHECK(r.status().step_mode == 1);
-  for (const char* next : {"fold/shift/contact", "fold/shift/press", "fold/shift/slide", "fold/grasp/fixate"}) {
+  for (const char* next : {"fold/shift/contact", "fold/shift/press", "fold/shift/slide",
+                           "fold/shift/check", "fold/grasp/fixate"}) {
     r.command(Command::step);
-    r.run(200);
+    r.run(700);  // shift/check waits for a model state settle_s (300 ms) on (read every 200 ms)
     CHECK(std::string(r.status().path) == next);
     CHECK(r.status().phase == SequenceStatus::paused);
   }

@@ -196,6 +196,9 @@ class Rig {
   std::uint32_t observations = 12;  // per sheet_state
   bool sheet_live = true;     // false: sheet_state no longer written (stale)
   bool pinch_carries = true;  // false: the pinch's goals leave the sheet where it lies (carry())
+  // In the shift, a hand pressing (force mode) drags the tracked sheet by this share of each of its
+  // arm's moves (1: with the finger; 0.5: half the way, the finger slipping over the sheet).
+  double shift_drag = 1.0;
   // Per arm goal (side, goal, index of the side's move goals): refuse as unreachable / never end.
   std::function<bool(int, const ArmGoal&, int)> unreachable = [](int, const ArmGoal&, int) { return false; };
   std::function<bool(int, const ArmGoal&, int)> stalls = [](int, const ArmGoal&, int) { return false; };
@@ -254,6 +257,49 @@ class Rig {
         true;  // published this cycle: the rig's motions are shorter than the model's period
   }
 
+  // Where side S's tool is put by goal G in the world (x, y; the tool's last known place for
+  // a measured goal's offset); false for a goal that says nothing of it.
+  bool goal_world_xy(int s, const ArmGoal& g, double out[2]) const {
+    if (g.point_count == 0) return false;
+    const double* p = g.position_mm[g.point_count - 1];
+    if (g.frame == ArmGoal::measured) {
+      if (!tool_known_[s]) return false;
+      out[0] = tool_xy_[s][0] + p[0];
+      out[1] = tool_xy_[s][1] + p[1];
+      return true;
+    }
+    double w[3] = {p[0], p[1], p[2]};
+    if (g.frame == ArmGoal::sheet) {
+      crease::fold::SheetFrame f;
+      if (!crease::fold::sheet_frame(*sheet_, f)) return false;
+      crease::fold::sheet_to_world(f, p, w);
+    }
+    out[0] = w[0];
+    out[1] = w[1];
+    return true;
+  }
+  // Goal G of side S ended where it aimed: in the shift, a pressing hand drags the sheet
+  // (shift_drag of the move); the tool's place is remembered for the next measured goal.
+  void tool_arrived(int s, const ArmGoal& g) {
+    double xy[2];
+    if (!goal_world_xy(s, g, xy)) return;
+    const bool pressing = hands_[s].st.mode == HandMode::force &&
+                          std::string_view(status().path).starts_with("fold/shift/");
+    if (pressing && tool_known_[s]) {
+      const double dx = shift_drag * (xy[0] - tool_xy_[s][0]),
+                   dy = shift_drag * (xy[1] - tool_xy_[s][1]);
+      drift(dx, dy);
+      for (auto& q : flat_) {
+        q[0] += static_cast<float>(dx);
+        q[1] += static_cast<float>(dy);
+      }
+      carried_new_ = true;
+    }
+    tool_xy_[s][0] = xy[0];
+    tool_xy_[s][1] = xy[1];
+    tool_known_[s] = true;
+  }
+
   void answer() {
     for (int s = 0; s < 2; ++s) {
       Arm& a = arms_[s];
@@ -266,12 +312,15 @@ class Rig {
           a.st.reason = static_cast<std::uint8_t>(a.abort_as);
         } else if (!a.stall && --a.left <= 0) {
           if (a.goal.stop_on == ArmGoal::contact_onset && !miss_contact[s]) {
+            tool_arrived(s,
+                         a.goal);  // (near enough: the rig's contacts are where the descent aims)
             a.st.state = ArmMotionStatus::stopped_on_contact;
             contact_[s].in_contact = 1;
             contact_[s].fingers = a.goal.stop_fingers;
             ++contact_[s].onsets;
           } else {
             a.st.state = ArmMotionStatus::reached;
+            tool_arrived(s, a.goal);
             carry(s, a.goal);
           }
         }
@@ -421,6 +470,8 @@ class Rig {
   int carried_ = -1;  // the node the pinch carries (carry()); -1: none yet
   std::array<std::array<float, 3>, 9> flat_{};  // where place_sheet laid each node
   bool carried_new_ = false;
+  double tool_xy_[2][2] = {};  // each tool's last known place (world x, y): tool_arrived()
+  bool tool_known_[2] = {false, false};
   LatestOutput<ArmMotionStatus> arm_out_[2];
   LatestOutput<HandControlStatus> hand_out_[2];
   LatestOutput<ContactState> contact_out_[2];

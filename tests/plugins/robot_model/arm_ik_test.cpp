@@ -276,3 +276,40 @@ TEST_CASE("set_tool, solve and track allocate nothing") {
   }
   CHECK(crease::rt::rt_allocation_count() == before);
 }
+
+// The two sides are mirror images across the world's x = 0 plane: the left arm at the right's
+// angles with its roll joints (S1, S3, E2, W2: axes along the links) negated, and the left hand at
+// the right's own angles, puts every tool frame at the right's mirrored (x -> -x) with its y axis
+// reversed (a mirrored frame turned right-handed again: z the pad's normal and x along the finger
+// stay). What a fold file for one hand becomes for the other (config/folds/).
+TEST_CASE(
+    "the left side mirrors the right: negated roll joints, the same hand, every tool frame "
+    "mirrored") {
+  std::mt19937 rng(11);
+  const KDL::Rotation mx(-1, 0, 0, 0, 1, 0, 0, 0, 1), flip_y(1, 0, 0, 0, -1, 0, 0, 0, 1);
+  double worst_mm = 0, worst_rad = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Joints qr = random_arm(model(), Side::right, rng);
+    const Hand hand = random_hand(model(), Side::right, rng);
+    Joints ql = qr;
+    for (int j : {0, 2, 4, 6}) ql[j] = -qr[j];
+    for (int j = 0; j < kArmJoints; ++j) {  // the mirrored angles are the left's to take
+      CHECK(model().arm_joints(Side::left)[j].lower_rad ==
+            -model().arm_joints(Side::right)[j].upper_rad);
+      CHECK(model().arm_joints(Side::left)[j].upper_rad ==
+            -model().arm_joints(Side::right)[j].lower_rad);
+    }
+    for (int f = 0; f < kToolFrames; ++f) {
+      const auto tool = static_cast<ToolFrame>(f);
+      const KDL::Frame r = truth(Side::right, tool, qr, hand),
+                       l = truth(Side::left, tool, ql, hand);
+      const KDL::Vector mirrored(-r.p.x(), r.p.y(), r.p.z());
+      worst_mm = std::max(worst_mm, 1000.0 * exact_norm(l.p - mirrored));
+      worst_rad = std::max(
+          worst_rad, rot_angle(l.M, tool == ToolFrame::flange ? mx * r.M * mx : mx * r.M * flip_y));
+    }
+  }
+  MESSAGE("worst: " << worst_mm << " mm, " << worst_rad << " rad");
+  CHECK(worst_mm < 1e-6);
+  CHECK(worst_rad < 1e-9);
+}

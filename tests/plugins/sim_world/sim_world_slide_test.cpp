@@ -4,6 +4,9 @@
 // the sheet stays where it was left when the finger lifts.
 // Failing variants: frictionless fingers drag nothing; a frictionless table lets even the
 // fabric finger drag the sheet, and lets it coast on after the finger has lifted.
+// And back over the table's edge: the sheet overhanging the far edge (folding's shift, seed 000
+// Fig. 7a) is dragged back over it, the paper sliding up over the edge's rounding; failing
+// variant: a square edge, whose side face the hanging paper meets and sticks to.
 #include <cmath>
 #include <string>
 
@@ -82,4 +85,23 @@ TEST_CASE("a pressed rubber fingertip drags the sheet, a fabric one slides over 
   const Slide r1 = slide(robot::Side::right, slippery_table);
   print("rubber, frictionless table", r1);
   CHECK_FALSE(stays_after_lift(r1));
+}
+
+TEST_CASE(
+    "a sheet overhanging the table's edge is dragged back over it; over a square edge it sticks") {
+  // The table's far edge 33.5 mm inside the sheet's (config/sim.yaml's overhang), the hanging
+  // paper drooping ~20 mm.
+  WorldParams over_edge = nominal();
+  over_edge.table_extent_mm = {-WorldParams::kNoEdge, WorldParams::kNoEdge, -WorldParams::kNoEdge,
+                               115.0};
+  const Slide round = slide(robot::Side::right, over_edge);
+  print("rubber, back over the rounded edge", round);
+  CHECK(round.shift_mm > 0.5 * kTravelMm);
+  CHECK(stays_after_lift(round));
+
+  WorldParams square = over_edge;
+  square.table_edge_radius_mm = 0.0;
+  const Slide stuck = slide(robot::Side::right, square);
+  print("rubber, back over a square edge", stuck);
+  CHECK(stuck.shift_mm < 0.25 * kTravelMm);
 }

@@ -46,6 +46,15 @@ TEST_CASE("table_extent_mm: absent a plane, given the slab's sides, null a side 
   CHECK(e[3] == WorldParams::kNoEdge);
 }
 
+TEST_CASE(
+    "table_edge_radius_mm: 5 mm unless given, 0-20 mm; out of range it names file, line and key") {
+  CHECK(read("").world.table_edge_radius_mm == 5.0);
+  CHECK(read("table_edge_radius_mm: 0\n").world.table_edge_radius_mm == 0.0);
+  const std::string e = error_of("table_edge_radius_mm: -1\n");
+  CHECK(e.find("sim.yaml:2") != std::string::npos);
+  CHECK(e.find("table_edge_radius_mm") != std::string::npos);
+}
+
 TEST_CASE("table_extent_mm: a malformed extent names file, line and key") {
   for (const char* bad : {"table_extent_mm: [1, 2, 3]\n", "table_extent_mm: 5\n", "table_extent_mm: [0, x, 0, 1]\n",
                           "table_extent_mm: [0, 1e9, 0, 1]\n", "table_extent_mm: [10, 0, 0, 1]\n"}) {
