@@ -361,10 +361,14 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::shift_approach:
       hand_posture(kFixing, f.open_rad, in, out);
       hand_posture(kPinching, f.open_rad, in, out);
-      approach(kFixing, f.shift, out);
+      approach(f.shift_role, f.shift, out);
       break;
-    case S::shift_contact: descend(kFixing, f.shift, out); break;
-    case S::shift_press: hand_force(kFixing, f.shift.fingers, f.shift.force_n, in, out); break;
+    case S::shift_contact:
+      descend(f.shift_role, f.shift, out);
+      break;
+    case S::shift_press:
+      hand_force(f.shift_role, f.shift.fingers, f.shift.force_n, in, out);
+      break;
     case S::shift_slide: {
       double d[2] = {0, 0}, w[2] = {0, 0};
       const double len = slide_length(in, d, w);
@@ -372,15 +376,35 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
         d[0] = d[1] = w[0] = w[1] = 0;  // the guard saw a sheet; a stale one here moves nothing
       if (m_.slides++ == 0) {           // from the press point, in the sheet's frame
         const double p[3] = {f.shift.at_mm[0] + d[0], f.shift.at_mm[1] + d[1], -f.slide_height_mm};
-        arm_move(kFixing, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+        arm_move(f.shift_role, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0,
+                 out);
       } else {  // the rest, from where the finger is (it slipped over the sheet): the corner's way
                 // in the world
         const double p[3] = {w[0], w[1], 0.0}, keep[4] = {0, 0, 0, 1};
-        arm_move(kFixing, f.shift.tool, ArmGoal::measured, p, keep, f.slide, 0, out);
+        arm_move(f.shift_role, f.shift.tool, ArmGoal::measured, p, keep, f.slide, 0, out);
       }
       break;
     }
-    case S::grasp_fixate: hand_force(kFixing, f.shift.fingers, f.fixate_force_n, in, out); break;
+    // The pinching hand shifted: it opens and lifts off, the fixing hand comes down on
+    // grasp.fixate.
+    case S::grasp_open:
+      hand_posture(kPinching, f.open_rad, in, out);
+      break;
+    case S::grasp_lift:
+      arm_lift(kPinching, f.shift_lift_mm, out);
+      break;
+    case S::grasp_park:
+      arm_park(kPinching, out, true);
+      break;
+    case S::grasp_fix_approach:
+      approach(kFixing, f.fixate, out);
+      break;
+    case S::grasp_fix_contact:
+      descend(kFixing, f.fixate, out);
+      break;
+    case S::grasp_fixate:
+      hand_force(kFixing, f.fixate.fingers, f.fixate_force_n, in, out);
+      break;
     case S::grasp_shape: hand_posture(kPinching, f.prepinch_rad, in, out); break;
     case S::grasp_above: {
       double path[kMaxGraspPath + 1][3], turn[kMaxGraspPath + 1][4];
@@ -424,9 +448,9 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::layer_lay: pinch_as_laid(f.lay_mm, out); break;
     case S::refix_slide_out: {
       // Out from under the bent layer along the table, pressing lightly: the near half stays.
-      hand_force(kFixing, f.shift.fingers, f.refixate_out_force_n, in, out);
+      hand_force(kFixing, f.fixate.fingers, f.refixate_out_force_n, in, out);
       const double p[3] = {f.refixate_out_mm[0], f.refixate_out_mm[1], -f.slide_height_mm};
-      arm_move(kFixing, f.shift.tool, ArmGoal::sheet, p, f.shift.orientation, f.slide, 0, out);
+      arm_move(kFixing, f.fixate.tool, ArmGoal::sheet, p, f.fixate.orientation, f.slide, 0, out);
       break;
     }
     case S::refix_open: hand_posture(kFixing, f.open_rad, in, out); break;

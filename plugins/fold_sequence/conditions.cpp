@@ -98,6 +98,14 @@ bool Machine::holds(Ev ev, S owner, const Sensing& in) const noexcept {
     case Ev::timeout: return timed_out(owner);
     case Ev::fault: return detected_ != Reason::none;
     case Ev::arm_fix_reached: return m_.arm_id[kFixing] != 0 && reached(kFixing);
+    case Ev::arm_shift_reached:
+      return m_.arm_id[spec_.shift_role] != 0 && reached(spec_.shift_role);
+    case Ev::arm_shift_contact:
+      return contact_stop(spec_.shift_role);
+    case Ev::arm_shift_missed:
+      return m_.arm_id[spec_.shift_role] != 0 && reached(spec_.shift_role);
+    case Ev::hand_shift_settled:
+      return settled(spec_.shift_role);
     case Ev::arm_pin_reached: return m_.arm_id[kPinching] != 0 && reached(kPinching);
     case Ev::arms_reached: return reached(kFixing) && reached(kPinching);
     case Ev::arm_fix_contact: return contact_stop(kFixing);
@@ -191,14 +199,22 @@ bool Machine::passes(Guard g, const Sensing& in) const noexcept {
     }
     case Guard::slide_short: return slide_length(in, d) <= spec_.shift_tolerance_mm;
     case Guard::slide_too_long: return slide_length(in, d) > spec_.max_slide_mm;
+    case Guard::shifted_by_fixing:
+      return spec_.shift_role == kFixing && slide_length(in, d) <= spec_.shift_tolerance_mm;
+    case Guard::shifted_by_pinching:
+      return spec_.shift_role == kPinching && slide_length(in, d) <= spec_.shift_tolerance_mm;
     case Guard::slide_again: {
       const double l = slide_length(in, d);
       return l > spec_.shift_tolerance_mm && l <= spec_.max_slide_mm &&
              m_.slides < spec_.max_slides;
     }
     case Guard::fixing_armed:
-    case Guard::pinching_armed: {
-      const ContactState* c = in.contact[g == Guard::fixing_armed ? kFixing : kPinching];
+    case Guard::pinching_armed:
+    case Guard::shift_armed: {
+      const int role = g == Guard::fixing_armed     ? kFixing
+                       : g == Guard::pinching_armed ? kPinching
+                                                    : spec_.shift_role;
+      const ContactState* c = in.contact[role];
       return c != nullptr && c->armed != 0 && c->healthy != 0;
     }
     case Guard::more_via: return m_.via + 1 < spec_.via_count;

@@ -222,6 +222,11 @@ void read(const Params& p, FoldSpec& f) {
   f.max_slides = a.get_in_range<int>("max_slides", 4, 1, 20);
   f.shift_settle_s = a.get_in_range<double>("settle_s", 0.3, 0.0, 10.0);
   f.slide_height_mm = a.get_in_range<double>("slide_height_mm", 0.0, -20.0, 50.0);
+  const std::string shifter = a.get<std::string>("hand", "fixing");
+  if (shifter != "fixing" && shifter != "pinching")
+    a.fail("hand", "must be fixing or pinching, not '" + shifter + "'");
+  f.shift_role = shifter == "pinching" ? 1 : 0;  // machine.h's role indices: kFixing 0, kPinching 1
+  f.shift_lift_mm = a.get_in_range<double>("lift_mm", 100.0, 0.0, 500.0);
 
   const Params b = p.child("grasp");
   f.fixate_force_n = b.get_in_range<double>("fixate_force_n", 2.0, 0.0, 10.0);
@@ -234,6 +239,13 @@ void read(const Params& p, FoldSpec& f) {
   f.grasp_path_count = grasp_points(b, "path", "at_mm", f.grasp_path_mm, nullptr);
   sheet_point(b, "at_mm", f.grasp_at_mm);
   quaternion(b, "orientation", f.grasp_orientation);
+  if (f.shift_role == 1) {
+    if (!b.has("fixate"))
+      b.fail("fixate", "required when shift.hand is pinching: where the fixing hand fixates");
+    f.fixate = contact_step(b.child("fixate"), 0, true);
+  } else {
+    f.fixate = f.shift;  // the fixing hand stays where it shifted
+  }
 
   const Params c = p.child("bend");
   const std::vector<Params> via = c.list("via");

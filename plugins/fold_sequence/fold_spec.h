@@ -93,6 +93,13 @@ struct FoldSpec {
   // within the tolerance; short of it (the finger slipped over the sheet) the rest is slid from
   // where the finger is, up to max_slides slides in all (then abort: shift_short).
   int max_slides = 4;
+  // The hand that shifts (the file's shift.hand): the fixing one (kFixing, the default: it stays
+  // and fixates) or the pinching one (kPinching: seed 000's rubber hand, where the fixing hand's
+  // cover grips paper less than the table does and slides over it; it then lets go and lifts,
+  // and the fixing hand comes down on `fixate`).
+  int shift_role = 0;
+  double shift_lift_mm =
+      100;  // the pinching hand's lift after it shifted, before it takes its pinch's posture
   double shift_settle_s = 0.3;
   double slide_height_mm = 0;      // the tool frame's height above the sheet while sliding
 
@@ -101,6 +108,10 @@ struct FoldSpec {
   // under its overhang) to at_mm, then closes to pinch_rad until the force controller measures
   // at least pinch_force_n on every finger of pinch_fingers with the posture's ramp ended.
   double fixate_force_n = 2;
+  // Where the fixing hand fixates (tool, fingers, at_mm, orientation, approach and contact
+  // depth): the shift's contact when the fixing hand shifted; grasp.fixate when the pinching one
+  // did.
+  ContactStep fixate;
   std::uint8_t grasp_tool = 4;
   std::uint8_t pinch_fingers = 0x11;  // th + ff
   double pinch_force_n = 0.2;

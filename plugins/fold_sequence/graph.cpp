@@ -27,6 +27,14 @@ const char* event_name(Ev e) {
     case Ev::hand_pin_posed: return "pinching hand posed";
     case Ev::hands_posed: return "hands posed";
     case Ev::pinched: return "pinched";
+    case Ev::arm_shift_reached:
+      return "shifting arm reached";
+    case Ev::arm_shift_contact:
+      return "shifting arm contact stop";
+    case Ev::arm_shift_missed:
+      return "shifting arm at depth, no contact";
+    case Ev::hand_shift_settled:
+      return "shifting hand settled";
     case Ev::crease_acked: return "crease in model";
     case Ev::sheet_settled:
       return "sheet settled";
@@ -47,6 +55,12 @@ const char* guard_name(Guard g) {
     case Guard::slide_too_long: return "slide too long";
     case Guard::slide_again:
       return "corner short, slides left";
+    case Guard::shifted_by_fixing:
+      return "corner in reach, fixing hand shifted";
+    case Guard::shifted_by_pinching:
+      return "corner in reach, pinching hand shifted";
+    case Guard::shift_armed:
+      return "shifting contact armed";
     case Guard::fixing_armed: return "fixing contact armed";
     case Guard::pinching_armed: return "pinching contact armed";
     case Guard::more_via: return "more via";

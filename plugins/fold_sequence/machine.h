@@ -11,10 +11,11 @@
 // by the operator stops the arms and holds the hands that press; resuming re-enters the state
 // (its commands sent again from where the robot is).
 //
-// The machine speaks of two roles, not sides: the fixing hand shifts the sheet and fixates it,
-// the pinching hand pinches, bends, swipes and hardens. Seed 000 (Fig. 7) gives the right hand
-// (taxels) the fixing and the left (PST) the pinching; a fold file may swap them (`hands.pinching`)
-// and the plugin binds each role to that side's ports.
+// The machine speaks of two roles, not sides: the fixing hand fixates the sheet (and shifts it,
+// unless the fold file gives the shift to the pinching hand: `shift.hand`), the pinching hand
+// pinches, bends, swipes and hardens. Seed 000 (Fig. 7) gives the right hand (taxels, rubber) the
+// shift and the fixing, the left (PST, fabric) the pinching; a fold file may swap them
+// (`hands.pinching`) and the plugin binds each role to that side's ports.
 #pragma once
 
 #include <cstdint>

@@ -17,6 +17,11 @@ constexpr std::array<StateInfo, kStateCount> kStatesTable = {{
     {S::shift_slide, S::shift, S::shift_slide, "slide"},
     {S::shift_check, S::shift, S::shift_check, "check"},
     {S::grasp, S::fold, S::grasp_fixate, "grasp"},
+    {S::grasp_open, S::grasp, S::grasp_open, "open"},
+    {S::grasp_lift, S::grasp, S::grasp_lift, "lift"},
+    {S::grasp_park, S::grasp, S::grasp_park, "park"},
+    {S::grasp_fix_approach, S::grasp, S::grasp_fix_approach, "fix_approach"},
+    {S::grasp_fix_contact, S::grasp, S::grasp_fix_contact, "fix_contact"},
     {S::grasp_fixate, S::grasp, S::grasp_fixate, "fixate"},
     {S::grasp_shape, S::grasp, S::grasp_shape, "shape"},
     {S::grasp_above, S::grasp, S::grasp_above, "above"},
@@ -83,28 +88,38 @@ constexpr Row kRows[] = {
      "fault"},  // reason: the detector's
     {S::fold, Ev::timeout, Guard::none, S::abort, Reason::timeout, "state timeout"},
 
-    {S::shift_approach, Ev::arm_fix_reached, Guard::fixing_armed, S::shift_contact, C,
-     "fixing tool above the press point"},
-    {S::shift_contact, Ev::arm_fix_contact, Guard::none, S::shift_press, C,
-     "fixing hand touches the sheet"},
-    {S::shift_contact, Ev::arm_fix_missed, Guard::none, S::abort, Reason::no_contact,
-     "no contact at the descent's depth"},
-    {S::shift_press, Ev::hand_fix_settled, Guard::slide_too_long, S::abort,
-     Reason::slide_out_of_range, "slide longer than max_slide_mm"},
-    {S::shift_press, Ev::hand_fix_settled, Guard::slide_needed, S::shift_slide, C,
-     "fixing force settled"},
-    {S::shift_press, Ev::hand_fix_settled, Guard::slide_short, S::grasp, C,
-     "corner already in reach"},
-    {S::shift_slide, Ev::arm_fix_reached, Guard::none, S::shift_check, C, "slide ended"},
+    // clang-format off
+    {S::shift_approach, Ev::arm_shift_reached, Guard::shift_armed, S::shift_contact, C, "shifting tool above the press point"},
+    {S::shift_contact, Ev::arm_shift_contact, Guard::none, S::shift_press, C, "shifting hand touches the sheet"},
+    {S::shift_contact, Ev::arm_shift_missed, Guard::none, S::abort, Reason::no_contact, "no contact at the descent's depth"},
+    {S::shift_press, Ev::hand_shift_settled, Guard::slide_too_long, S::abort, Reason::slide_out_of_range,
+     "slide longer than max_slide_mm"},
+    {S::shift_press, Ev::hand_shift_settled, Guard::slide_needed, S::shift_slide, C, "shifting force settled"},
+    {S::shift_press, Ev::hand_shift_settled, Guard::shifted_by_fixing, S::grasp_fixate, C, "corner already in reach"},
+    {S::shift_press, Ev::hand_shift_settled, Guard::shifted_by_pinching, S::grasp_open, C, "corner already in reach"},
+    {S::shift_slide, Ev::arm_shift_reached, Guard::none, S::shift_check, C, "slide ended"},
     // Shifted is what the tracked sheet says once the model has caught up, not the arm's arrival:
     // a finger that slipped over the sheet left the corner short (the rest is slid again).
-    {S::shift_check, Ev::sheet_settled, Guard::slide_short, S::grasp, C, "sheet shifted"},
+    {S::shift_check, Ev::sheet_settled, Guard::shifted_by_fixing, S::grasp_fixate, C, "sheet shifted"},
+    {S::shift_check, Ev::sheet_settled, Guard::shifted_by_pinching, S::grasp_open, C, "sheet shifted"},
     {S::shift_check, Ev::sheet_settled, Guard::slide_too_long, S::abort, Reason::slide_out_of_range,
      "slide longer than max_slide_mm"},
-    {S::shift_check, Ev::sheet_settled, Guard::slide_again, S::shift_slide, C,
-     "corner short of its target: slide on"},
+    {S::shift_check, Ev::sheet_settled, Guard::slide_again, S::shift_slide, C, "corner short of its target: slide on"},
     {S::shift_check, Ev::sheet_settled, Guard::none, S::abort, Reason::shift_short,
      "corner short of its target after max_slides"},
+
+    // The pinching hand shifted: it lets go and lifts, then the fixing hand comes down to fixate.
+    {S::grasp_open, Ev::hand_pin_posed, Guard::none, S::grasp_lift, C, "shifting hand open"},
+    {S::grasp_lift, Ev::arm_pin_reached, Guard::none, S::grasp_park, C, "shifting hand lifted"},
+    // Parked (in joint space) as at the start, from where the grasp's way was made: from over the
+    // sheet its first motion was refused (unreachable).
+    {S::grasp_park, Ev::arm_pin_reached, Guard::none, S::grasp_fix_approach, C, "shifting hand parked"},
+    {S::grasp_fix_approach, Ev::arm_fix_reached, Guard::fixing_armed, S::grasp_fix_contact, C,
+     "fixing tool above the fixation point"},
+    {S::grasp_fix_contact, Ev::arm_fix_contact, Guard::none, S::grasp_fixate, C, "fixing hand touches the sheet"},
+    {S::grasp_fix_contact, Ev::arm_fix_missed, Guard::none, S::abort, Reason::no_contact,
+     "no contact at the descent's depth"},
+    // clang-format on
 
     {S::grasp_fixate, Ev::hand_fix_settled, Guard::none, S::grasp_shape, C, "fixing hand fixates"},
     // Shaped before the arm moves: arm_motion takes the tool frame's offset from the hand as it

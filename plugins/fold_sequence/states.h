@@ -19,89 +19,46 @@
 
 namespace crease::fold {
 
+// clang-format off
 enum class S : std::uint8_t {
   root,
   idle,
   fold,
-  shift,
-  shift_approach,
-  shift_contact,
-  shift_press,
-  shift_slide,
-  shift_check,
-  grasp,
-  grasp_fixate,
-  grasp_shape,
-  grasp_above,
-  grasp_reach,
-  grasp_pinch,
-  bend,
-  bend_crease,
-  follow_via,
-  fixate_layer,
-  layer_lay,
-  refixate,
-  refix_slide_out,
-  refix_open,
-  refix_lift,
-  refix_approach,
-  refix_contact,
-  refix_press,
-  swipe,
-  swipe_release,
-  swipe_withdraw,
-  swipe_open,
-  swipe_lift,
-  swipe_approach,
-  swipe_contact,
-  swipe_press,
-  swipe_slide,
-  harden,
-  harden_open,
-  harden_lift,
-  harden_approach,
-  harden_contact,
-  harden_press,
-  harden_slide,
-  finish,
-  finish_memorize,
-  finish_open,
-  finish_lift,
-  finish_park,
+  shift, shift_approach, shift_contact, shift_press, shift_slide, shift_check,
+  grasp, grasp_open, grasp_lift, grasp_park, grasp_fix_approach, grasp_fix_contact, grasp_fixate, grasp_shape, grasp_above,
+  grasp_reach, grasp_pinch,
+  bend, bend_crease, follow_via,
+  fixate_layer, layer_lay,
+  refixate, refix_slide_out, refix_open, refix_lift, refix_approach, refix_contact, refix_press,
+  swipe, swipe_release, swipe_withdraw, swipe_open, swipe_lift, swipe_approach, swipe_contact, swipe_press, swipe_slide,
+  harden, harden_open, harden_lift, harden_approach, harden_contact, harden_press, harden_slide,
+  finish, finish_memorize, finish_open, finish_lift, finish_park,
   done,
-  abort,
-  abort_stop,
-  abort_open,
-  abort_lift,
-  abort_reopen,
-  abort_park,
+  abort, abort_stop, abort_open, abort_lift, abort_reopen, abort_park,
   aborted,
   count
 };
+// clang-format on
 inline constexpr int kStateCount = static_cast<int>(S::count);
 static_assert(kStateCount <= kStates, "FoldSpec keeps one timeout per state");
 
 // What makes a row fire: a condition of the sensing against what the state commanded.
+// clang-format off
 enum class Ev : std::uint8_t {
-  start,    // the operator's start
-  timeout,  // the row's state has been in it longer than its timeout
-  fault,    // a fault of the sensing (Reason says which); fold's rows only
-  arm_fix_reached,
-  arm_pin_reached,
-  arms_reached,  // the state's arm goal(s) reached
-  arm_fix_contact,
-  arm_pin_contact,  // stopped on a contact onset
-  arm_fix_missed,
-  arm_pin_missed,  // a contact descent reached its depth untouched
-  hand_fix_settled,
-  hand_pin_settled,  // force settled on the state's force goal
-  hand_fix_posed,
-  hand_pin_posed,
-  hands_posed,    // the state's posture goal done
+  start,          // the operator's start
+  timeout,        // the row's state has been in it longer than its timeout
+  fault,          // a fault of the sensing (Reason says which); fold's rows only
+  arm_fix_reached, arm_pin_reached, arms_reached,   // the state's arm goal(s) reached
+  arm_fix_contact, arm_pin_contact,                 // stopped on a contact onset
+  arm_fix_missed, arm_pin_missed,                   // a contact descent reached its depth untouched
+  hand_fix_settled, hand_pin_settled,               // force settled on the state's force goal
+  hand_fix_posed, hand_pin_posed, hands_posed,      // the state's posture goal done
+  // The same of the shift's hand (the fold file's shift.hand: the fixing one, or the pinching
+  // one, the rubber-covered hand that shifts in seed 000 Fig. 7a).
+  arm_shift_reached, arm_shift_contact, arm_shift_missed, hand_shift_settled,
   pinched,        // the pinching hand's closing ended with the pinch fingers squeezing (force_n)
   crease_acked,   // sheet_state carries one crease more than when the state began
-  sheet_settled,  // a sheet_state taken settle_s or more after the state began (the model caught
-                  // up)
+  sheet_settled,  // a sheet_state taken settle_s or more after the state began (the model caught up)
   memorized,      // a sheet_state newer than the memorize request (the model consumed it)
   stopped,        // abort: both hands took the hold goal (or retreat on their own, or refused
                   // it), and neither arm runs a motion
@@ -109,20 +66,25 @@ enum class Ev : std::uint8_t {
                   // one short for a reason that may pass is sent again, retry_retreat)
   always,         // at once (a completion)
 };
+// clang-format on
 
+// clang-format off
 enum class Guard : std::uint8_t {
   none,
-  ready,  // start: every controller answers (fresh; contact healthy; the hand commanded), the sheet
-          // is seen
+  ready,           // start: every controller answers (fresh; contact healthy; the hand commanded), the sheet is seen
   slide_needed,    // shift: the corner is further than the tolerance from its target
   slide_short,     // shift: not needed (already there)
   slide_too_long,  // shift: longer than max_slide_mm
   slide_again,     // shift: slide_needed, and fewer than max_slides slides so far
+  shifted_by_fixing,    // shift: slide_short, and the fixing hand shifted (it stays and fixates)
+  shifted_by_pinching,  // shift: slide_short, and the pinching hand shifted (it lets go, the fixing one comes)
   fixing_armed,    // the hand's contact_state is armed, healthy: a contact motion may start
   pinching_armed,
-  more_via,  // bend: via points left
+  shift_armed,     // ... the shift's hand's
+  more_via,        // bend: via points left
   last_via,
 };
+// clang-format on
 
 // Why the machine left a state: the last transition's reason, the abort's reason.
 enum class Reason : std::uint8_t {

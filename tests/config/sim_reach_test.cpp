@@ -1,18 +1,18 @@
 // Can the simulated robot reach the sheet where config/sim.yaml lays it? The folding sequence's
-// first goals (config/folds/half.yaml and diagonal.yaml: the fixing hand's approach and contact,
-// the pinching hand's grasp: above the edge, round it, at the pinch) in arm_motion's sheet frame
-// of the world's sheet (sim.yaml's corner, turn and table) at its nominal pose and at the
-// randomisation's extremes (sim_world: +-30 mm, +-15 deg), solved with the arm's IK (robot_model's
-// ArmIk, the URDF's joint limits) from the rest posture and its restarts, as given (which must be
-// reached) and turned about the sheet's normal (72 turns, 5 deg apart: how many are). Prints, per
-// goal, the shoulder's distance to the tool and the IK's residual. Failing variant: the arms
-// mounted as before (1.3 m over the table, 450 mm behind the sheet's centre). Then the pinching
-// arm's grasp from the world's parked pose, as arm_motion checks a path (failing variant: the
-// straight turn from the parked pose, without above_via). At the shift's contact,
-// the open hand's shells (plastic) clear of the sheet by more than the descent's depth over its
-// lowest fingertip cover; failing variant: the pad flat on the sheet. And the half fold's bend
-// from the pinch through its via points to 120 deg as arm_motion checks a path; failing variant:
-// the via points' orientations without the pinch's own turn.
+// first goals (config/folds/half.yaml and diagonal.yaml: the shifting hand's approach and contact,
+// the fixing hand's, the pinching hand's grasp: above the edge, round it, at the pinch) in
+// arm_motion's sheet frame of the world's sheet (sim.yaml's corner, turn and table) at its nominal
+// pose and at the randomisation's extremes (sim_world: +-30 mm, +-15 deg), solved with the arm's IK
+// (robot_model's ArmIk, the URDF's joint limits) from the rest posture and its restarts, as given
+// (which must be reached) and turned about the sheet's normal (72 turns, 5 deg apart: how many
+// are). Prints, per goal, the shoulder's distance to the tool and the IK's residual. Failing
+// variant: the arms mounted as before (1.3 m over the table, 450 mm behind the sheet's centre).
+// Then the pinching arm's grasp from the world's parked pose, as arm_motion checks a path (failing
+// variant: the straight turn from the parked pose, without above_via). At the shift's contact, the
+// open hand's shells (plastic) clear of the sheet by more than the descent's depth over its lowest
+// fingertip cover; failing variant: the pad flat on the sheet. And the half fold's bend from the
+// pinch through its via points to 120 deg as arm_motion checks a path; failing variant: the via
+// points' orientations without the pinch's own turn.
 #include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -82,6 +82,10 @@ KDL::Frame shifted_sheet(const Layout& l, const fold::FoldSpec& f, double yaw) {
 
 Side fixing(const fold::FoldSpec& f) { return f.pinching_side == 0 ? Side::left : Side::right; }
 Side pinching(const fold::FoldSpec& f) { return f.pinching_side == 0 ? Side::right : Side::left; }
+// The hand that shifts the sheet (shift.hand): the fixing one, or the pinching one (half.yaml).
+Side shifting(const fold::FoldSpec& f) {
+  return f.shift_role == 1 ? pinching(f) : fixing(f);
+}
 Hand posture(const float* rad) {
   Hand h{};
   for (int j = 0; j < robot::kHandJoints; ++j) h[j] = rad[j];
@@ -133,6 +137,9 @@ int unreachable_goals(const robot::RobotModel& m, const std::string& fold, const
         const KDL::Frame sheet = sheet_frame(l, dx, dy, yaw_deg * std::numbers::pi / 180.0);
         const double approach[3] = {f.shift.at_mm[0], f.shift.at_mm[1], -f.shift.approach_height_mm};
         const double contact[3] = {f.shift.at_mm[0], f.shift.at_mm[1], 0.0};
+        const double fix_approach[3] = {f.fixate.at_mm[0], f.fixate.at_mm[1],
+                                        -f.fixate.approach_height_mm};
+        const double fix_contact[3] = {f.fixate.at_mm[0], f.fixate.at_mm[1], 0.0};
         struct Goal {
           std::string what;
           Side side;
@@ -142,9 +149,16 @@ int unreachable_goals(const robot::RobotModel& m, const std::string& fold, const
           Hand hand;
         };
         std::vector<Goal> goals = {
-            {"shift approach", fixing(f), f.shift.tool, approach, f.shift.orientation, posture(f.open_rad)},
-            {"shift contact", fixing(f), f.shift.tool, contact, f.shift.orientation, posture(f.open_rad)},
-            {"grasp above", pinching(f), f.grasp_tool, f.grasp_above_mm, f.grasp_orientation, posture(f.prepinch_rad)},
+            {"shift approach", shifting(f), f.shift.tool, approach, f.shift.orientation,
+             posture(f.open_rad)},
+            {"shift contact", shifting(f), f.shift.tool, contact, f.shift.orientation,
+             posture(f.open_rad)},
+            {"fixate approach", fixing(f), f.fixate.tool, fix_approach, f.fixate.orientation,
+             posture(f.open_rad)},
+            {"fixate contact", fixing(f), f.fixate.tool, fix_contact, f.fixate.orientation,
+             posture(f.open_rad)},
+            {"grasp above", pinching(f), f.grasp_tool, f.grasp_above_mm, f.grasp_orientation,
+             posture(f.prepinch_rad)},
         };
         for (int k = 0; k < f.grasp_path_count; ++k)
           goals.push_back({"grasp path " + std::to_string(k), pinching(f), f.grasp_tool, f.grasp_path_mm[k],
@@ -359,14 +373,14 @@ TEST_CASE("at the shift's contact the open hand touches the sheet with its finge
   const robot::RobotModel m = robot::RobotModel::load(kConfig + "robot/crease_robot.yaml");
   const fold::FoldSpec f = fold::load_fold_file(kConfig + "folds/half.yaml");
   // As shipped: the palm pitched 30 deg (the fingers down, the wrist up).
-  const Clearance shipped = contact_clearance(m, fixing(f), f.shift, f.shift.orientation);
+  const Clearance shipped = contact_clearance(m, shifting(f), f.shift, f.shift.orientation);
   MESSAGE("half: the lowest shell (" << shipped.lowest_shell << ") " << shipped.shell_over_cover_mm
                                      << " mm over the lowest fingertip cover");
   CHECK(shipped.shell_over_cover_mm > f.shift.contact_depth_mm);
   // Failing variant: the pad flat on the sheet, the fingers along world +y as shipped (turned
   // about the normal only): the forearm's flange shell, the thumb, wrist and palm hang below the pads.
   const double flat[4] = {0, 0, 0.70711, 0.70711};
-  const Clearance before = contact_clearance(m, fixing(f), f.shift, flat);
+  const Clearance before = contact_clearance(m, shifting(f), f.shift, flat);
   MESSAGE("half, the pad flat: the lowest shell (" << before.lowest_shell << ") " << before.shell_over_cover_mm
                                                    << " mm over the lowest fingertip cover");
   CHECK(before.shell_over_cover_mm < 0.0);

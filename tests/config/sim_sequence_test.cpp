@@ -41,17 +41,18 @@ rt::LatestReader<T> reader(PluginHost& host, const std::string& port) {
 
 std::string path_of(const SequenceStatus& s) { return std::string(s.path, strnlen(s.path, sizeof s.path)); }
 
-// The half fold's fixing hand (config/folds/half.yaml: the left one presses and slides the sheet).
-constexpr int kFixing = 1;
+// The half fold's shifting hand (config/folds/half.yaml: the right, rubber-covered one presses and
+// slides the sheet, seed 000 Fig. 7a).
+constexpr int kShifting = 0;
 
-// The world's fixing index pad: its height (mm) and the largest normal force of any fingertip.
+// The world's shifting index pad: its height (mm) and the largest normal force of any fingertip.
 struct Tips {
-  double fixing_ff_z_mm = 0, max_force_n = 0, min_z_mm = 1e9, max_joint_rad = 0;
+  double shifting_ff_z_mm = 0, max_force_n = 0, min_z_mm = 1e9, max_joint_rad = 0;
   bool touching = false;
 };
 Tips tips(const WorldState& w) {
   Tips t;
-  t.fixing_ff_z_mm = w.hand[kFixing].tip[0].position_mm[2];
+  t.shifting_ff_z_mm = w.hand[kShifting].tip[0].position_mm[2];
   for (const WorldHand& h : w.hand) {
     t.touching = t.touching || h.palm_contact != 0;
     for (const WorldFingertip& f : h.tip) {
@@ -99,13 +100,14 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
   REQUIRE(status.value().phase == SequenceStatus::running);
   REQUIRE(world.poll().has_data());
   const Tips start = tips(world.value());
-  MESSAGE("started: " << path_of(status.value()) << ", the fixing index pad " << start.fixing_ff_z_mm << " mm up");
+  MESSAGE("started: " << path_of(status.value()) << ", the shifting index pad "
+                      << start.shifting_ff_z_mm << " mm up");
 
-  // Its first state: both hands to the open posture (force_X), the fixing arm's approach above
+  // Its first state: both hands to the open posture (force_X), the shifting arm's approach above
   // the sheet (motion_l, solved ahead against the real arm_state). It moves on when arm_motion
   // answers: reached (then the contact descent), or refused. Until the press, at most 40 s.
   std::string path = path_of(status.value()), deepest = path;
-  double lowest_mm = start.fixing_ff_z_mm, press_force_n = 0;
+  double lowest_mm = start.shifting_ff_z_mm, press_force_n = 0;
   const auto deeper = [](const std::string& p) {
     return p == "fold/shift/press" || p == "fold/shift/slide" || p == "fold/shift/check" ||
            p.rfind("fold/grasp", 0) == 0;
@@ -118,8 +120,10 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
     links.poll();
     if (world.poll().is_new()) {
       const Tips t = tips(world.value());
-      lowest_mm = std::min(lowest_mm, t.fixing_ff_z_mm);
-      if (deeper(path)) press_force_n = std::max(press_force_n, double(world.value().hand[kFixing].tip[0].normal_force_n));
+      lowest_mm = std::min(lowest_mm, t.shifting_ff_z_mm);
+      if (deeper(path))
+        press_force_n =
+            std::max(press_force_n, double(world.value().hand[kShifting].tip[0].normal_force_n));
     }
     if (path_of(status.value()) != path) {
       path = path_of(status.value());
@@ -140,17 +144,18 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
   for (const rt::ThreadInfo& th : rt::list_threads())
     loops += th.name + " " + th.policy + " " + std::to_string(th.priority) + " cpus " + rt::format_cpu_list(th.cpus) + "; ";
   MESSAGE("the simulated link until here:\n" << links.summary() << loops);
-  MESSAGE("deepest state " << deepest << ", the fixing index pad down to " << lowest_mm << " mm, pressing " << press_force_n
-                           << " N; " << (status.value().phase == SequenceStatus::running
-                                             ? std::string("running")
-                                             : "aborted: " + std::string(status.value().why)));
+  MESSAGE("deepest state " << deepest << ", the shifting index pad down to " << lowest_mm
+                           << " mm, pressing " << press_force_n << " N; "
+                           << (status.value().phase == SequenceStatus::running
+                                   ? std::string("running")
+                                   : "aborted: " + std::string(status.value().why)));
   if (!wired) {
     // Its motion never answers: it does not leave the approach for an answer of arm_motion
     // (reached, unreachable; a fault of a loaded machine may still abort it) and nothing moves
     // in the world.
     CHECK(deepest == "fold/shift/approach");
     CHECK(own_reason != 7);  // unreachable: arm_motion's answer, which never came
-    CHECK(std::fabs(lowest_mm - start.fixing_ff_z_mm) < 1.0);
+    CHECK(std::fabs(lowest_mm - start.shifting_ff_z_mm) < 1.0);
     host.stop();
     return;
   }
@@ -162,7 +167,7 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
   CHECK(own_reason != 4);  // device_fault
   CHECK(own_reason != 8);  // goal_refused
   const bool moved = deepest != "fold/shift/approach";
-  if (moved) CHECK(lowest_mm < start.fixing_ff_z_mm - 20.0);  // the world's fingertip went down
+  if (moved) CHECK(lowest_mm < start.shifting_ff_z_mm - 20.0);  // the world's fingertip went down
 
   // creasectl sequence abort (or the sequence's own): stop, open, lift, park, until aborted.
   REQUIRE(world.poll().has_data());

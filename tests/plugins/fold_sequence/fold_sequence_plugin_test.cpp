@@ -385,6 +385,72 @@ TEST_CASE(
         doctest::Approx(std::hypot(25.0, 20.0)).epsilon(1e-3));
 }
 
+TEST_CASE(
+    "the shipped half fold: the pinching (rubber) hand shifts, lets go and lifts; the fixing hand "
+    "comes down and fixates") {
+  Rig r(fold_file("half.yaml"));
+  r.command(Command::start);
+  REQUIRE(r.run_to("done"));
+  std::vector<std::string> expected = kHalfPath;
+  const auto at = std::find(expected.begin(), expected.end(), "fold/grasp/fixate");
+  REQUIRE(at != expected.end());
+  expected.insert(at, {"fold/grasp/open", "fold/grasp/lift", "fold/grasp/park",
+                       "fold/grasp/fix_approach", "fold/grasp/fix_contact"});
+  CHECK(r.paths() == expected);
+  CHECK(r.allocations() == 0);
+
+  // (a) by the pinching hand: above its press point, down to a contact, the press, the slide.
+  const auto pin_arm = r.all(kPin, Sent::arm);
+  REQUIRE(pin_arm.size() >= 4);
+  const ArmGoal& ap = pin_arm[0]->arm_goal;
+  CHECK(ap.frame == ArmGoal::sheet);
+  CHECK(ap.position_mm[0][0] == 105.0);
+  CHECK(ap.position_mm[0][1] == 88.5);
+  CHECK(ap.position_mm[0][2] == -30.0);
+  CHECK(pin_arm[1]->arm_goal.stop_on == ArmGoal::contact_onset);
+  // The slide: (25, 21.5) mm in the world, (-25, +21.5) along the turned sheet's u and v.
+  CHECK(near(pin_arm[2]->arm_goal.position_mm[0][0], 105.0 - 25.0));
+  CHECK(near(pin_arm[2]->arm_goal.position_mm[0][1], 88.5 + 21.5));
+  // Then it lets go and lifts straight up from where it is.
+  const ArmGoal& lift = pin_arm[3]->arm_goal;
+  CHECK(lift.frame == ArmGoal::measured);
+  CHECK(lift.position_mm[0][2] == 100.0);  // shift.lift_mm
+  REQUIRE(pin_arm.size() >= 5);
+  CHECK(pin_arm[4]->arm_goal.frame == ArmGoal::world);  // then to its park, in joint space
+  CHECK(pin_arm[4]->arm_goal.interpolation == ArmGoal::joints);
+  const auto ph = r.all(kPin, Sent::hand);
+  REQUIRE(ph.size() >= 3);
+  CHECK(ph[1]->hand_goal.mode == HandMode::force);
+  CHECK(ph[1]->hand_goal.force_n == 1.5f);
+  CHECK(ph[2]->hand_goal.mode == HandMode::posture);  // open before the lift
+  CHECK(ph[2]->cycle < pin_arm[3]->cycle);
+  // (b) the fixing hand's first motion comes after that lift: above grasp.fixate, down, the
+  // fixation.
+  const auto fix_arm = r.all(kFix, Sent::arm);
+  REQUIRE(fix_arm.size() >= 2);
+  CHECK(fix_arm[0]->cycle > pin_arm[4]->cycle);
+  CHECK(fix_arm[0]->arm_goal.frame == ArmGoal::sheet);
+  CHECK(fix_arm[0]->arm_goal.position_mm[0][0] == 165.0);
+  CHECK(fix_arm[0]->arm_goal.position_mm[0][1] == 88.5);
+  CHECK(fix_arm[0]->arm_goal.position_mm[0][2] == -30.0);
+  CHECK(fix_arm[1]->arm_goal.stop_on == ArmGoal::contact_onset);
+  CHECK(fix_arm[1]->arm_goal.stop_fingers == 0x03);
+  bool fixated = false;
+  for (const Sent* h : r.all(kFix, Sent::hand))
+    if (h->hand_goal.mode == HandMode::force && h->hand_goal.force_n == 2.0f &&
+        h->hand_goal.fingers == 0x03)
+      fixated = true;
+  CHECK(fixated);
+
+  // Failing variant: the fixing hand's descent touching nothing aborts no_contact, hands open.
+  Rig missed(fold_file("half.yaml"));
+  missed.command(Command::start);
+  REQUIRE(missed.run_to("fold/grasp/fix_approach"));
+  missed.miss_contact[kFix] = true;
+  expect_abort(missed, crease::fold::Reason::no_contact);
+  CHECK(missed.paths()[missed.paths().size() - kRetreat.size() - 1] == "fold/grasp/fix_contact");
+}
+
 TEST_CASE("a laid layer that springs back once the pinch let go aborts the swipe as fold_lost") {
   // A trial (seed 15): the pinch opened, the layer sprang back over the fixing hand's press and the
   // sequence swiped and hardened a sheet lying unfolded, to `done`.
@@ -718,7 +784,7 @@ TEST_CASE("the retreat sends a lift or park again that ended short for a reason 
         std::filesystem::temp_directory_path() / ("crease_fold_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     {
-      std::ifstream in(fold_file("half.yaml"));
+      std::ifstream in(half_fixing_shift());
       std::ofstream out(dir / "half.yaml");
       out << in.rdbuf() << "\npark_lift_mm: 0\n";
     }
@@ -824,7 +890,7 @@ TEST_CASE(
   CHECK(slides >= 2);
   CHECK(slides <= 4);
   CHECK(checks == slides);
-  CHECK(std::hypot(corner_xy(r)[0] - 0.0, corner_xy(r)[1] - 148.5) <= 3.0);  // shift.tolerance_mm
+  CHECK(std::hypot(corner_xy(r)[0] - 0.0, corner_xy(r)[1] - 148.5) <= 8.0);  // shift.tolerance_mm
   CHECK(std::string(r.status().why) == "sheet shifted");
   // The first slide in the sheet's frame from the press point, the others from where the tool is.
   std::vector<const Sent*> moves;

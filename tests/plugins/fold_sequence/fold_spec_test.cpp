@@ -60,6 +60,12 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.fold_line_mm[0][1] == 148.5);
   CHECK(h.via_mm[1][2] == -60.3);  // [u, v, h]: h above the sheet is the sheet frame's -z
   CHECK(h.shift.fingers == 0x03);
+  CHECK(h.shift_role == 1);  // the pinching (rubber) hand shifts
+  CHECK(h.shift.at_mm[0] == 105.0);
+  CHECK(h.shift_lift_mm == 100.0);
+  CHECK(h.fixate.at_mm[0] == 165.0);  // grasp.fixate: where the fixing hand comes down
+  CHECK(h.fixate.fingers == 0x03);
+  CHECK(h.fixate.approach_height_mm == 30.0);
   CHECK(h.lay_mm[1] == 14.5);
   CHECK(h.lay_mm[2] == -22.0);
   CHECK(h.refixate_out_mm[0] == 255.0);
@@ -99,13 +105,15 @@ TEST_CASE("the shipped folds load") {
   CHECK(d.fold_lost_mm == 0.0);
   CHECK(d.fold_line_mm[1][0] == 210.0);
   CHECK(d.via_count == 5);
+  CHECK(d.shift_role == 0);  // absent: the fixing hand shifts and fixates where it pressed
+  CHECK(d.fixate.at_mm[0] == d.shift.at_mm[0]);
 }
 
 TEST_CASE("malformed sequence files name the file, the line and the key") {
   const std::string tmp = (std::filesystem::temp_directory_path() / "crease_fold_spec_test.yaml").string();
   SUBCASE("a missing file") { CHECK(error_of("/nonexistent/fold.yaml").find("/nonexistent/fold.yaml") == 0); }
   SUBCASE("YAML that does not parse") {
-    const std::string e = error_of(variant("  at_mm: [165, 88.5]", "  at_mm: [165, 88.5"));
+    const std::string e = error_of(variant("  at_mm: [105, 88.5]", "  at_mm: [105, 88.5"));
     CHECK(e.find(tmp + ":") == 0);
     CHECK(e.find("fold") != std::string::npos);
   }
@@ -132,6 +140,18 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     CHECK(error_of(variant("  lay_mm: [105, 14.5, 22]\n", "  {}\n"))
               .find("fold.fixate_layer.lay_mm: required") != std::string::npos);
     CHECK(error_of(variant("  out_mm: [255, 88.5]", "  out_mm: [255]")).find("fold.refixate.out_mm: expected a list of 2") !=
+          std::string::npos);
+  }
+  SUBCASE(
+      "the shift's hand: fixing or pinching; a pinching one needs where the fixing hand fixates") {
+    CHECK(error_of(variant("  hand: pinching", "  hand: thumbs"))
+              .find("fold.shift.hand: must be fixing or pinching") != std::string::npos);
+    const std::size_t a = read_all(shipped("half.yaml")).find("  fixate: {");
+    const std::size_t b = read_all(shipped("half.yaml")).find("}\n", a);
+    REQUIRE(a != std::string::npos);
+    const std::string fixate = read_all(shipped("half.yaml")).substr(a, b + 2 - a);
+    CHECK(error_of(variant(fixate, ""))
+              .find("fold.grasp.fixate: required when shift.hand is pinching") !=
           std::string::npos);
   }
   SUBCASE("an unknown finger") {

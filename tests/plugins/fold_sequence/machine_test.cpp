@@ -74,13 +74,14 @@ TEST_CASE("a command the plugin could not queue aborts the fold with command_los
   m.fill_status(st, 1'000'000);
   CHECK(std::string(st.path) == "fold/shift/approach");
   CHECK(std::string(st.why) == "start");
-  CHECK(out.arm_count[kFixing] == 1);
+  CHECK(out.arm_count[kPinching] == 1);  // half.yaml: the pinching (rubber) hand shifts
+  CHECK(out.arm_count[kFixing] == 0);
   CHECK(out.hand_count[kFixing] == 1);
   CHECK(out.hand_count[kPinching] == 1);
   m.step(q.at(2'000'000), out);  // nothing finished: it waits
   m.fill_status(st, 2'000'000);
   CHECK(std::string(st.path) == "fold/shift/approach");
-  CHECK(out.arm_count[kFixing] == 0);
+  CHECK(out.arm_count[kPinching] == 0);
   m.fail(Reason::command_lost);
   m.step(q.at(3'000'000), out);
   m.fill_status(st, 3'000'000);

@@ -39,28 +39,37 @@ TEST_CASE("every state of the fold reaches abort on a fault, and has a way out o
 }
 
 TEST_CASE("the success rows lead from idle through (a)-(h) to done, every leaf of the fold on the way") {
+  // Once with the fixing hand shifting, once with the pinching one (the grasp's open, lift and
+  // the fixing hand's approach and contact): every leaf of the fold on one of the ways.
   std::set<S> seen;
-  S s = S::idle;
-  int via = 0;
-  for (int guard = 0; guard < 200 && s != S::done; ++guard) {
-    seen.insert(s);
-    const Row* next = nullptr;
-    for (const Row* r = rows_of(s).begin; r != rows_of(s).end; ++r) {
-      if (r->ev == Ev::timeout || r->ev == Ev::fault || is_within(r->to, S::abort)) continue;
-      if (r->guard == Guard::slide_short && s == S::shift_press) continue;  // the slide's branch
-      if (r->guard == Guard::slide_again) continue;                         // one slide shifts it
-      if (r->guard == Guard::more_via && via >= 4) continue;
-      if (r->guard == Guard::last_via && via < 4) continue;
-      next = r;
-      break;
+  for (const bool pinching_shifts : {false, true}) {
+    CAPTURE(pinching_shifts);
+    S s = S::idle;
+    int via = 0;
+    for (int guard = 0; guard < 200 && s != S::done; ++guard) {
+      seen.insert(s);
+      const Row* next = nullptr;
+      for (const Row* r = rows_of(s).begin; r != rows_of(s).end; ++r) {
+        if (r->ev == Ev::timeout || r->ev == Ev::fault || is_within(r->to, S::abort)) continue;
+        if (s == S::shift_press &&
+            (r->guard == Guard::shifted_by_fixing || r->guard == Guard::shifted_by_pinching))
+          continue;                                    // the slide's branch
+        if (r->guard == Guard::slide_again) continue;  // one slide shifts it
+        if (r->guard == (pinching_shifts ? Guard::shifted_by_fixing : Guard::shifted_by_pinching))
+          continue;
+        if (r->guard == Guard::more_via && via >= 4) continue;
+        if (r->guard == Guard::last_via && via < 4) continue;
+        next = r;
+        break;
+      }
+      REQUIRE_MESSAGE(next != nullptr, path(s));
+      if (next->to == s) ++via;
+      S to = next->to;
+      while (!is_leaf(to)) to = state_info(to).initial;
+      s = to;
     }
-    REQUIRE_MESSAGE(next != nullptr, path(s));
-    if (next->to == s) ++via;
-    S to = next->to;
-    while (!is_leaf(to)) to = state_info(to).initial;
-    s = to;
+    CHECK(s == S::done);
   }
-  CHECK(s == S::done);
   for (int i = 1; i < kStateCount; ++i) {
     const S x = static_cast<S>(i);
     if (is_leaf(x) && is_within(x, S::fold)) CHECK_MESSAGE(seen.count(x) == 1, path(x));
