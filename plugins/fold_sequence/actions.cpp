@@ -214,10 +214,10 @@ void Machine::push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) no
 }
 
 void Machine::hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out,
-                           const float* stiffness) noexcept {
+                           const float* stiffness, double ramp_s) noexcept {
   HandGoal g{};
   g.mode = HandMode::posture;
-  g.ramp_s = static_cast<float>(spec_.posture_ramp_s);
+  g.ramp_s = static_cast<float>(ramp_s >= 0 ? ramp_s : spec_.posture_ramp_s);
   for (int j = 0; j < kHandJoints; ++j) g.target_rad[j] = target_rad[j];
   if (stiffness != nullptr) {
     g.set_stiffness = 1;
@@ -459,7 +459,8 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::refix_contact: descend(kFixing, f.refixate, out); break;
     case S::refix_press: hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out); break;
     case S::swipe_release:
-      hand_posture(kPinching, f.prepinch_rad, in, out, f.has_release_stiffness ? f.release_stiffness : nullptr);
+      hand_posture(kPinching, f.prepinch_rad, in, out,
+                   f.has_release_stiffness ? f.release_stiffness : nullptr, f.release_ramp_s);
       break;
     case S::swipe_withdraw: pinch_as_laid(f.swipe_withdraw_mm, out); break;
     case S::swipe_open:

@@ -211,6 +211,7 @@ void read(const Params& p, FoldSpec& f) {
     f.has_release_stiffness = true;
   }
   f.posture_ramp_s = h.get_in_range<double>("ramp_s", 0.3, 0.0, 60.0);
+  f.release_ramp_s = h.get_in_range<double>("release_ramp_s", f.posture_ramp_s, 0.0, 60.0);
   f.force_ramp_s = h.get_in_range<double>("force_ramp_s", 0.1, 0.0, 60.0);
 
   const Params a = p.child("shift");

@@ -80,6 +80,8 @@ struct FoldSpec {
   float release_stiffness[kHandJoints] = {};
   bool has_release_stiffness = false;
   double posture_ramp_s = 0.3;
+  double release_ramp_s =
+      0.3;  // the pinch's opening over the laid layer (swipe/release); ramp_s if absent
   double force_ramp_s = 0.1;       // a force goal's target ramp
 
   // (a) shift: the fixing hand presses at shift.at, then slides the sheet so that `corner_mm`

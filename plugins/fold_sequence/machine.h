@@ -242,9 +242,10 @@ class Machine {
   // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
   // pinch as the bend laid it (lay, withdraw).
   void pinch_as_laid(const double p[3], Outbox& out) noexcept;
-  // STIFFNESS (N m/rad, 20 joints) or nullptr: the controller's stiffness kept.
+  // STIFFNESS (N m/rad, 20 joints) or nullptr: the controller's stiffness kept; RAMP_S (s) < 0:
+  // the file's ramp_s.
   void hand_posture(int side, const float* target_rad, const Sensing& in, Outbox& out,
-                    const float* stiffness = nullptr) noexcept;
+                    const float* stiffness = nullptr, double ramp_s = -1) noexcept;
   void hand_force(int side, std::uint8_t fingers, double force_n, const Sensing& in, Outbox& out) noexcept;
   void hand_hold(int side, const Sensing& in, Outbox& out) noexcept;
   void approach(int side, const ContactStep& c, Outbox& out) noexcept;     // above c.at

@@ -303,6 +303,8 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(pin_hand_after[0]->hand_goal.target_rad[3] == doctest::Approx(1.428));  // the index still curled
   CHECK(pin_hand_after[0]->hand_goal.set_stiffness == 1);  // half.yaml's release_stiffness: a soft thumb
   CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[15] == doctest::Approx(0.5));
+  CHECK(pin_hand_after[0]->hand_goal.ramp_s ==
+        doctest::Approx(1.5));  // release_ramp_s: it opens slowly
   CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[0] == doctest::Approx(30.0));
   const InSheet withdraw = in_sheet(pinching[11]->arm_goal, sh);
   CHECK(pinching[11]->cycle >= pin_hand_after[0]->cycle + r.posture_cycles);

@@ -77,6 +77,8 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.prepinch_rad[3] == doctest::Approx(1.428));
   CHECK(h.pinch_rad[15] == doctest::Approx(0.77));  // THJ5 closed
   CHECK(h.has_release_stiffness);
+  CHECK(h.release_ramp_s == 1.5);
+  CHECK(h.posture_ramp_s == 0.3);
   CHECK(h.pinch_lost_mm == 50.0);
   CHECK(h.pinch_lost_s == 0.3);
   CHECK(h.fold_lost_mm == 100.0);
@@ -100,6 +102,7 @@ TEST_CASE("the shipped folds load") {
   CHECK(d.grasp_path_count == 0);
   for (int j = 0; j < kHandJoints; ++j) CHECK(d.prepinch_rad[j] == d.open_rad[j]);  // absent: open
   CHECK_FALSE(d.has_release_stiffness);  // absent: the controller's stiffness kept
+  CHECK(d.release_ramp_s == d.posture_ramp_s);  // absent: ramp_s
   CHECK(d.pinch_lost_mm == 0.0);         // absent: not checked
   CHECK(d.pinch_lost_s == 0.0);
   CHECK(d.fold_lost_mm == 0.0);
