@@ -293,7 +293,7 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(fix_hand_after[1]->cycle >= fix_after[0]->cycle + r.move_cycles);
   CHECK(near(in_sheet(fix_after[2]->arm_goal, sh).p[1], 100.0));  // over both layers, by the crease
   // (f) once both layers are held, the pinch opens to prepinch (the thumb only), then its pads
-  // leave the edge (straight up), then the hand opens.
+  // draw back along the layer towards the crease, then the hand opens.
   const auto pin_hand_after = r.all(kPin, Sent::hand, pinching[10]->cycle);
   REQUIRE(pin_hand_after.size() >= 2);
   const auto fix_force = r.all(kFix, Sent::hand, fix_after[3]->cycle);
@@ -308,8 +308,8 @@ TEST_CASE("a whole half fold: every state of Fig. 7 in order, each goal as the f
   CHECK(pin_hand_after[0]->hand_goal.stiffness_nm_per_rad[0] == doctest::Approx(30.0));
   const InSheet withdraw = in_sheet(pinching[11]->arm_goal, sh);
   CHECK(pinching[11]->cycle >= pin_hand_after[0]->cycle + r.posture_cycles);
-  CHECK(near(withdraw.p[1], 14.5));
-  CHECK(near(withdraw.p[2], -37.0));  // straight up off the laid edge
+  CHECK(near(withdraw.p[1], 44.5));  // back along the layer, towards the crease
+  CHECK(near(withdraw.p[2], -24.0));
   CHECK(pin_hand_after[1]->cycle >= pinching[11]->cycle + r.move_cycles);
   for (float t : pin_hand_after[1]->hand_goal.target_rad) CHECK(t == 0.0f);  // open
   // (g) the hardening stroke along the model's crease, inset 10 mm, 4 mm onto the stack.
