@@ -193,21 +193,17 @@ bool Machine::passes(Guard g, const Sensing& in) const noexcept {
       }
       return true;
     }
-    case Guard::slide_needed: {
-      const double l = slide_length(in, d);
-      return l > spec_.shift_tolerance_mm && l <= spec_.max_slide_mm;
-    }
-    case Guard::slide_short: return slide_length(in, d) <= spec_.shift_tolerance_mm;
-    case Guard::slide_too_long: return slide_length(in, d) > spec_.max_slide_mm;
-    case Guard::shifted_by_fixing:
-      return spec_.shift_role == kFixing && slide_length(in, d) <= spec_.shift_tolerance_mm;
-    case Guard::shifted_by_pinching:
-      return spec_.shift_role == kPinching && slide_length(in, d) <= spec_.shift_tolerance_mm;
+    case Guard::slide_needed:
     case Guard::slide_again: {
       const double l = slide_length(in, d);
       return l > spec_.shift_tolerance_mm && l <= spec_.max_slide_mm &&
-             m_.slides < spec_.max_slides;
+             (g == Guard::slide_needed || m_.slides < spec_.max_slides);
     }
+    case Guard::slide_too_long: return slide_length(in, d) > spec_.max_slide_mm;
+    case Guard::shifted_by_fixing:
+    case Guard::shifted_by_pinching:  // the corner within the tolerance, and that hand shifted
+      return spec_.shift_role == (g == Guard::shifted_by_fixing ? kFixing : kPinching) &&
+             slide_length(in, d) <= spec_.shift_tolerance_mm;
     case Guard::fixing_armed:
     case Guard::pinching_armed:
     case Guard::shift_armed: {

@@ -51,7 +51,6 @@ const char* guard_name(Guard g) {
     case Guard::none: return "";
     case Guard::ready: return "controllers, sheet ready";
     case Guard::slide_needed: return "slide needed";
-    case Guard::slide_short: return "corner in reach";
     case Guard::slide_too_long: return "slide too long";
     case Guard::slide_again:
       return "corner short, slides left";

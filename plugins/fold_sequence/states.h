@@ -73,11 +73,10 @@ enum class Guard : std::uint8_t {
   none,
   ready,           // start: every controller answers (fresh; contact healthy; the hand commanded), the sheet is seen
   slide_needed,    // shift: the corner is further than the tolerance from its target
-  slide_short,     // shift: not needed (already there)
   slide_too_long,  // shift: longer than max_slide_mm
   slide_again,     // shift: slide_needed, and fewer than max_slides slides so far
-  shifted_by_fixing,    // shift: slide_short, and the fixing hand shifted (it stays and fixates)
-  shifted_by_pinching,  // shift: slide_short, and the pinching hand shifted (it lets go, the fixing one comes)
+  shifted_by_fixing,    // shift: the corner within the tolerance, and the fixing hand shifted (it stays and fixates)
+  shifted_by_pinching,  // shift: the same, and the pinching hand shifted (it lets go, the fixing one comes)
   fixing_armed,    // the hand's contact_state is armed, healthy: a contact motion may start
   pinching_armed,
   shift_armed,     // ... the shift's hand's

@@ -211,9 +211,8 @@ void World::add_table_slab() {
   const double h = params_.table_height_mm, r = params_.table_edge_radius_mm;
   const double x0 = std::max(e[0], -1000.0), x1 = std::min(e[1], 1000.0);
   const double y0 = std::max(e[2], -1000.0), y1 = std::min(e[3], 1000.0);
-  const bool edge[4] = {e[0] > -WorldParams::kNoEdge,
-                        e[1]<WorldParams::kNoEdge, e[2]> - WorldParams::kNoEdge,
-                        e[3] < WorldParams::kNoEdge};
+  const auto has_edge = [](double v) { return std::fabs(v) < WorldParams::kNoEdge; };
+  const bool edge[4] = {has_edge(e[0]), has_edge(e[1]), has_edge(e[2]), has_edge(e[3])};
   if (!(r > 0)) {
     table_.add_box({x1 - x0, y1 - y0, 50.0}, {0.5 * (x0 + x1), 0.5 * (y0 + y1), h - 25.0});
     return;
@@ -231,15 +230,11 @@ void World::add_table_slab() {
   const double along_y[9] = {1, 0, 0, 0, 0, 1, 0, -1, 0};  // capsule z -> world y
   for (int k = 0; k < 4; ++k) {
     if (!edge[k]) continue;
-    if (k < 2) {  // x = x0 or x1: the edge runs along y
-      const int id =
-          table_.add_capsule(r, ty1 - ty0, {k == 0 ? x0 + r : x1 - r, 0.5 * (ty0 + ty1), h - r});
-      table_.set_pose(id, {k == 0 ? x0 + r : x1 - r, 0.5 * (ty0 + ty1), h - r}, along_y);
-    } else {  // y = y0 or y1: along x
-      const int id =
-          table_.add_capsule(r, tx1 - tx0, {0.5 * (tx0 + tx1), k == 2 ? y0 + r : y1 - r, h - r});
-      table_.set_pose(id, {0.5 * (tx0 + tx1), k == 2 ? y0 + r : y1 - r, h - r}, along_x);
-    }
+    const bool runs_along_y = k < 2;  // x = x0 or x1; else y = y0 or y1, along x
+    const Vec3 c = runs_along_y ? Vec3{k == 0 ? x0 + r : x1 - r, 0.5 * (ty0 + ty1), h - r}
+                                : Vec3{0.5 * (tx0 + tx1), k == 2 ? y0 + r : y1 - r, h - r};
+    const int id = table_.add_capsule(r, runs_along_y ? ty1 - ty0 : tx1 - tx0, c);
+    table_.set_pose(id, c, runs_along_y ? along_y : along_x);
   }
 }
 
