@@ -21,6 +21,9 @@ SheetModel::SheetModel(const SheetParams& params)
     : params_(params), topo_(build_topology(params.grid, params.topology)) {
   const SolverParams& s = params_.solver;
   require(s.substeps >= 1 && s.substeps <= 1000, "solver.substeps", "must be in [1, 1000]");
+  require(s.max_strain >= 0 && s.max_strain <= 1, "solver.max_strain", "must be in [0, 1]");
+  require(s.strain_limit_sweeps >= 1 && s.strain_limit_sweeps <= 100, "solver.strain_limit_sweeps",
+          "must be in [1, 100]");
   require(s.stiffness > 0 && s.stiffness <= 1, "solver.stiffness", "must be in (0, 1]");
   require(s.crease_stiffness > 0 && s.crease_stiffness <= 1, "solver.crease_stiffness",
           "must be in (0, 1]");

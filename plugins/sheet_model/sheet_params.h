@@ -104,6 +104,12 @@ struct SolverParams {
   // normal alone, a flap that turns ahead of the model is pushed out along its tangent each frame
   // (its hinge rises off the crease); along the bisector the pull follows the chord of the turn.
   bool depth_surface_normal = true;
+  // Strain limiting (strain_limit.h): structural links longer than (1 + max_strain) x their rest
+  // length are shortened to it after each substep's contacts, in strain_limit_sweeps sweeps.
+  // 0: off (the tracking model follows what it sees); the simulated world's paper does not
+  // stretch.
+  double max_strain = 0.0;
+  int strain_limit_sweeps = 4;
   // Contacts: Coulomb friction coefficient against rigid shapes.
   double friction = 0.5;
   // ... and between layers (paper on paper; position-based: a node's slip over the triangle

@@ -29,6 +29,10 @@ class SubstepContacts {
   // the sheet's contact candidates (table, layers) must cover it. Called once per frame
   // before the substeps. RT.
   [[nodiscard]] virtual double max_push_mm(double dt_s) const noexcept = 0;
+
+  // Per node, after solve_rt: how firmly these contacts hold it in this substep, as a mass (kg;
+  // strain_limit.h: the friction it can take, mu F, over 1 g). Empty: they hold nothing. RT.
+  [[nodiscard]] virtual std::span<const double> hold_mass_kg() const noexcept { return {}; }
 };
 
 }  // namespace crease::sheet

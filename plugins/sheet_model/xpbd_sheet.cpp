@@ -77,6 +77,7 @@ XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
       if (!s.plastic_bending_only || topo_.kind[k] == LinkKind::bending) plastic_links_.push_back(k);
   }
   contacts_.configure(topo_, params_.grid, s);
+  strain_limit_.configure(topo_, rest_);
 }
 
 void XpbdSheet::set_positions(std::span<const Vec3> pos) noexcept {
@@ -308,6 +309,11 @@ void XpbdSheet::step_rt(double dt) noexcept {
     project_targets();
     project_normal_targets();
     if (substep_contacts_ != nullptr) substep_contacts_->solve_rt(x_, prev_, w_, s, ns, dts);
+    if (sp.max_strain > 0) {  // after the external contacts (their holds), before the layers
+      const auto hold = substep_contacts_ != nullptr ? substep_contacts_->hold_mass_kg()
+                                                     : std::span<const double>{};
+      strain_limit_.project_rt(x_, w_, hold, sp.max_strain, sp.strain_limit_sweeps);
+    }
     const int every = std::max(1, sp.self_collision_every);
     contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);
     update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit

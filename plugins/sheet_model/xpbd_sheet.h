@@ -3,7 +3,9 @@
 //   key-point velocities (seed 000 Eqs. 1-4) -> prediction (seed 001 Eq. 1) ->
 //   links, Gauss-Seidel, one pass, lambda = 0 per substep (seed 001 Eqs. 2-3) ->
 //   zero-length target springs (seed 001 Eq. 4) -> external substep contacts, if set
-//   (substep_contacts.h: the world's fingers) -> contacts (table, shapes; layers every
+//   (substep_contacts.h: the world's fingers) -> strain limit (strain_limit.h,
+//   solver.max_strain > 0 only; the external contacts' holds) -> contacts (table, shapes;
+//   layers every
 //   solver.self_collision_every substeps and on the last) -> velocities from positions ->
 //   plastic update (seed 001 III.C; every solver.plasticity_every substeps).
 // Link constants are rebuilt only when links_version() or dt_s change; target-spring
@@ -28,6 +30,7 @@
 #include "keypoint_coupling.h"
 #include "link_kernel.h"
 #include "sheet_model.h"
+#include "strain_limit.h"
 #include "substep_contacts.h"
 
 namespace crease::sheet {
@@ -94,6 +97,7 @@ class XpbdSheet final : public SheetModel {
   std::uint64_t substeps_done_ = 0;          // since construction (plasticity_every counts them)
   SubstepContacts* substep_contacts_ = nullptr;
   ContactSolver contacts_;
+  StrainLimit strain_limit_;
   std::vector<Vec3> x_detect_;       // positions at the last contact detection
   double detect_margin_mm_ = -1.0;   // margin of the last detection; < 0: detect next frame
   const CollisionWorld* detect_world_ = nullptr;

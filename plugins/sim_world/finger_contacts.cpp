@@ -63,6 +63,7 @@ void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const W
   node_area_mm2_.resize(n);
   for (int i = 0; i < n; ++i) node_area_mm2_[i] = sheet.node_masses_kg()[i] / kg_per_mm2;
   slot_of_node_.assign(n, -1);
+  hold_kg_.assign(n, 0.0);
   touched_.resize(n);
   shape_near_.assign(shape_count, 0);
   springback_mm_.assign(shape_count, 0.0);
@@ -77,7 +78,10 @@ void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const W
 
 void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3> v, double dt) noexcept {
   const WorldShape* shapes = shapes_;
-  for (int k = 0; k < n_touched_; ++k) slot_of_node_[touched_[k].node] = -1;
+  for (int k = 0; k < n_touched_; ++k) {
+    slot_of_node_[touched_[k].node] = -1;
+    hold_kg_[touched_[k].node] = 0.0;
+  }
   n_touched_ = 0;
   max_push_mm_ = 0;
   for (int s = 0; s < n_shapes_; ++s) {
@@ -386,7 +390,10 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
     bool any = false;
     const int mm = gather_rt(t, p, dts, c, any);
     if (!any) {
-      if (pass == 0) return;
+      if (pass == 0) {
+        hold_kg_[t.node] = 0.0;
+        return;
+      }
       break;
     }
     m = mm;
@@ -395,6 +402,9 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
   }
   // Reactions on the shapes, averaged over the step: mN -> N.
   const double inv_dts2 = 1.0 / (dts * dts);
+  double hold_mn = 0;  // the friction the node can take, mu F (mN)
+  for (int e = 0; e < m; ++e) hold_mn += c[e].mu * c[e].lambda * inv_dts2;
+  hold_kg_[t.node] = hold_mn / kHoldAccelMmS2;
   for (int e = 0; e < m; ++e) {
     if (c[e].shape < 0) continue;
     ShapeLoad& l = load_[c[e].shape];

@@ -105,6 +105,10 @@ class FingerContacts final : public sheet::SubstepContacts {
   void solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std::span<const double> w, int substep, int substeps,
                 double dt_s) noexcept override;
   [[nodiscard]] double max_push_mm(double dt_s) const noexcept override;
+  // Per node, the friction its contacts (shapes and the table under it) can take in the last
+  // substep, mu F summed, over 1 g: the sheet's strain limit moves firmly held nodes least.
+  [[nodiscard]] std::span<const double> hold_mass_kg() const noexcept override { return hold_kg_; }
+  static constexpr double kHoldAccelMmS2 = 9810.0;
   // The contacts between the nodes touched in the last step (at positions x) and the shapes at
   // POSES (one per shape): residuals(). RT.
   void measure_rt(std::span<const Pose> poses, std::span<const Vec3> x) noexcept;
@@ -156,6 +160,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   double du_ = 0, dv_ = 0, half_thickness_ = 0.5;
   double patch_reach_ = 0;  // mm: a patch's farthest point from its node (half its cell's diagonal)
   std::vector<double> node_area_mm2_;
+  std::vector<double> hold_kg_;             // per node: hold_mass_kg (0: not touched)
   std::vector<std::int32_t> slot_of_node_;  // -1: not touched this step
   std::vector<Touched> touched_;
   int n_touched_ = 0;

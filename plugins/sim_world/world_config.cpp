@@ -74,6 +74,8 @@ WorldPluginConfig read_world_config(const Params& p) {
   g.origin_mm.y = p.get_in_range<double>("origin_y_mm", g.origin_mm.y, -1000.0, 1000.0);
   g.turn_deg = p.get_in_range<double>("sheet_turn_deg", g.turn_deg, -180.0, 180.0);
   w.sheet.solver.substeps = p.get_in_range<int>("substeps", w.sheet.solver.substeps, 1, 16);
+  w.sheet.solver.max_strain =
+      p.get_in_range<double>("max_strain", w.sheet.solver.max_strain, 0.0, 0.2);
   w.table_height_mm = p.get_in_range<double>("table_height_mm", w.table_height_mm, -500.0, 500.0);
   read_table_extent(p, w.table_extent_mm);
   w.table_edge_radius_mm =

@@ -31,6 +31,10 @@ namespace crease::world {
   p.solver.plasticity_rate = 0.95;
   p.solver.plasticity_every = 20;        // every 10 ms
   p.solver.crease_strain = 0.0;          // the tracking model's guess at a crease; the world's is physics
+  // The strain limit (strain_limit.h; the `max_strain` parameter) is off: it holds the paper's
+  // length where the hands pull it, but the fold scenes' pinch then slips and loses the edge
+  // (README.md, "A strain limit for the paper").
+  p.solver.max_strain = 0.0;
   return p;
 }
 

@@ -86,6 +86,20 @@ TEST_CASE(
   }
 }
 
+TEST_CASE(
+    "max_strain: off (0) by default, as given within 0-0.2; out of range it names file, line and "
+    "key") {
+  CHECK(read("").world.sheet.solver.max_strain == 0.0);
+  CHECK(read("max_strain: 0.01\n").world.sheet.solver.max_strain == 0.01);
+  CHECK(read("max_strain: 0.02\n").world.sheet.solver.max_strain == 0.02);
+  for (const char* bad : {"max_strain: -0.01\n", "max_strain: 0.3\n", "max_strain: stiff\n"}) {
+    const std::string e = error_of(bad);
+    INFO(bad << " -> " << e);
+    CHECK(e.find("sim.yaml:2") != std::string::npos);
+    CHECK(e.find("max_strain") != std::string::npos);
+  }
+}
+
 // The devices' command watchdog: a real device's 20 ms unless the configuration says
 // (config/sim.yaml: 100, as the drivers' tolerance of the shared machine's stalls); the simulated
 // robot takes it.
