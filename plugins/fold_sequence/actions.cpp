@@ -4,6 +4,7 @@
 // resolves when each motion starts; the parking poses in the world frame.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "plugins/fold_sequence/machine.h"
 #include "plugins/fold_sequence/sheet_geometry.h"
@@ -163,10 +164,15 @@ bool Machine::back_out_of_bend(const Sensing& in, Outbox& out) noexcept {
     for (int c = 0; c < 4; ++c) turn[n][c] = q[c];
     ++n;
   };
-  for (int i = passed - 1; i >= 0 && n < room; i -= step) add(f.via_mm[i], f.via_orientation[i]);
+  double vq[4];
+  for (int i = passed - 1; i >= 0 && n < room; i -= step) {
+    via_orientation(i, vq);
+    add(f.via_mm[i], vq);
+  }
   if ((passed - 1) % step != 0) {  // via 0 skipped by the step: it ends the bend's way back
     if (n == room) --n;
-    add(f.via_mm[0], f.via_orientation[0]);
+    via_orientation(0, vq);
+    add(f.via_mm[0], vq);
   }
   add(f.grasp_above_mm, f.grasp_orientation);
   for (int i = f.grasp_above_via_count - 1; i >= 0; --i) {
@@ -195,9 +201,22 @@ bool Machine::joints_park_due(int s, const Sensing& in) const noexcept {
   return why == ArmMotionReason::unreachable || why == ArmMotionReason::joint_speed;
 }
 
+void Machine::via_orientation(int k, double q[4]) const noexcept {
+  const FoldSpec& f = spec_;
+  for (int c = 0; c < 4; ++c) q[c] = f.via_orientation[k][c];
+  if (!f.bend_yaw_limited || m_.frame_held == 0) return;
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  const double yaw = std::remainder(frame_yaw(m_.held_frame) - f.bend_yaw_reference_deg * kDeg,
+                                    2 * std::numbers::pi);
+  const double kept =
+      std::clamp(yaw, f.bend_yaw_range_deg[0] * kDeg, f.bend_yaw_range_deg[1] * kDeg);
+  if (kept != yaw) turn_about_vertical(m_.held_frame, kept - yaw, f.via_orientation[k], q);
+}
+
 void Machine::pinch_as_laid(const double p[3], Outbox& out) noexcept {
-  arm_move(kPinching, spec_.grasp_tool, ArmGoal::sheet, p, spec_.via_orientation[spec_.via_count - 1], spec_.contact,
-           0, out);
+  double q[4];
+  via_orientation(spec_.via_count - 1, q);
+  arm_move(kPinching, spec_.grasp_tool, ArmGoal::sheet, p, q, spec_.contact, 0, out);
 }
 
 void Machine::push_hand(int side, HandGoal g, const Sensing& in, Outbox& out) noexcept {
@@ -440,10 +459,13 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
       m_.crease_count0 = in.sheet != nullptr ? in.sheet->crease_count : 0;
       m_.frame_held = in.sheet != nullptr && sheet_frame(*in.sheet, m_.held_frame) ? 1 : 0;
       break;
-    case S::follow_via:
+    case S::follow_via: {
       if (m_.self_entry) ++m_.via;  // the next via point; re-entered on resume: the same one
-      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], f.via_orientation[m_.via], f.fold, 0, out);
+      double q[4];
+      via_orientation(m_.via, q);
+      arm_move(kPinching, f.grasp_tool, ArmGoal::sheet, f.via_mm[m_.via], q, f.fold, 0, out);
       break;
+    }
     case S::bend_crease: m_.via = 0; break;
     case S::layer_lay: pinch_as_laid(f.lay_mm, out); break;
     case S::refix_slide_out: {

@@ -259,6 +259,17 @@ void read(const Params& p, FoldSpec& f) {
     f.via_orientation[i][3] = 1;
     quaternion(v, "orientation", f.via_orientation[i]);
   }
+  if (c.has("yaw_range_deg") || c.has("yaw_reference_deg")) {
+    f.bend_yaw_limited = true;
+    if (!c.has("yaw_reference_deg"))
+      c.fail("yaw_reference_deg",
+             "required with yaw_range_deg: the heading the via points were drawn for");
+    f.bend_yaw_reference_deg = c.get_in_range<double>("yaw_reference_deg", 0.0, -180.0, 180.0);
+    numbers(c, "yaw_range_deg", 2, f.bend_yaw_range_deg);
+    if (!(f.bend_yaw_range_deg[0] <= 0 && f.bend_yaw_range_deg[1] >= 0 &&
+          f.bend_yaw_range_deg[0] >= -90 && f.bend_yaw_range_deg[1] <= 90))
+      c.fail("yaw_range_deg", "expected [low, high] deg with -90 <= low <= 0 <= high <= 90");
+  }
 
   sheet_point(p.child("fixate_layer"), "lay_mm", f.lay_mm);
   const Params rf = p.child("refixate");

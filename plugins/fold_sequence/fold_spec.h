@@ -134,6 +134,12 @@ struct FoldSpec {
   int via_count = 0;
   double via_mm[kMaxVia][3] = {};
   double via_orientation[kMaxVia][4] = {};
+  // The via points' orientations turn with the sheet's heading only within this range (deg)
+  // about the heading they were drawn for (the sheet's u axis at yaw_reference_deg in the world):
+  // the points follow the sheet, the pad's turn stays within the arm's reach. Unset: all the way.
+  bool bend_yaw_limited = false;
+  double bend_yaw_reference_deg = 0;
+  double bend_yaw_range_deg[2] = {-180, 180};
 
   // (d) the pinch lays the bent layer on the stack and holds it there: the pinching tool to
   // lay_mm (sheet frame), turned as the last via point.

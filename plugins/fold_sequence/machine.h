@@ -241,6 +241,9 @@ class Machine {
   [[nodiscard]] int bend_passed() const noexcept;
   // The pinching tool to P (sheet frame) at contact speed, turned as the last via point: the
   // pinch as the bend laid it (lay, withdraw).
+  // Via point K's orientation (sheet frame), turned back about the vertical by what the bend's
+  // heading at the held frame exceeds the fold file's yaw range by (FoldSpec::bend_yaw_*).
+  void via_orientation(int k, double q[4]) const noexcept;
   void pinch_as_laid(const double p[3], Outbox& out) noexcept;
   // STIFFNESS (N m/rad, 20 joints) or nullptr: the controller's stiffness kept; RAMP_S (s) < 0:
   // the file's ramp_s.

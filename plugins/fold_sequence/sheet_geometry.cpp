@@ -84,6 +84,19 @@ bool sheet_frame(const SheetState& s, SheetFrame& f) noexcept {
   return true;
 }
 
+double frame_yaw(const SheetFrame& f) noexcept {
+  return std::atan2(f.x[1], f.x[0]);
+}
+
+void turn_about_vertical(const SheetFrame& f, double alpha_rad, const double q[4],
+                         double q_out[4]) noexcept {
+  const Eigen::Quaterniond r(rotation(f));
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(alpha_rad, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond out =
+      r.conjugate() * turn * r * Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
+  q_out[0] = out.x(), q_out[1] = out.y(), q_out[2] = out.z(), q_out[3] = out.w();
+}
+
 bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept {
   if (!usable(s) || !std::isfinite(u) || !std::isfinite(v)) return false;
   const int i = std::clamp(static_cast<int>(std::lround(u / s.width_mm * (s.nodes_u - 1))), 0, s.nodes_u - 1);

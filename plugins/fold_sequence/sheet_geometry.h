@@ -26,6 +26,12 @@ void world_to_sheet(const SheetFrame& f, const double p[3], const double q[4], d
 // orientation turned by F's rotation (the inverse of world_to_sheet).
 void sheet_to_world(const SheetFrame& f, const double p[3], const double q[4], double p_out[3],
                     double q_out[4]) noexcept;
+// The heading of F's x axis (u) about the world's vertical: atan2(x_y, x_x), rad.
+[[nodiscard]] double frame_yaw(const SheetFrame& f) noexcept;
+// Sheet-frame orientation Q turned by ALPHA rad about the world's vertical, again in F's
+// coordinates.
+void turn_about_vertical(const SheetFrame& f, double alpha_rad, const double q[4],
+                         double q_out[4]) noexcept;
 // The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
 [[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
 // The crease of s nearest to the segment a-b (sheet mm, by the sum of its end points'

@@ -11,10 +11,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "plugins/fold_sequence/fold_spec.h"
 #include "sequence_rig.h"
 
 using namespace rig;
@@ -1002,4 +1005,59 @@ TEST_CASE("the command tunable takes integers only") {
   Rig r;
   CHECK(r.plugin().validate_param("command", 1.0).empty());
   CHECK_FALSE(r.plugin().validate_param("command", 1.5).empty());
+}
+
+// bend.yaw_range_deg (half.yaml: -10 to +20 deg about u along the world's -x): a sheet lying
+// turned -18 deg keeps its via points, but the pad's turn follows it only to -10 deg (turned back
+// 8 deg about the vertical); failing variant: the same fold without the range turns the pad all
+// the way (the trials' right arm lost the bend's top so).
+TEST_CASE("the bend's pad turns with the sheet's heading only within the fold file's yaw range") {
+  const double yaw = -18.0 * std::numbers::pi / 180.0;
+  auto via3_turn = [&](const std::string& fold, double q[4], crease::fold::SheetFrame& f) {
+    Rig r(fold);
+    r.place_sheet(80, -170, true, yaw);
+    bool seen = false;
+    r.stalls = [&](int side, const ArmGoal& g, int) {
+      if (side == kPin && g.frame == ArmGoal::sheet && near(g.position_mm[0][1], 148.5) &&
+          g.position_mm[0][2] < -100 && !seen) {
+        for (int c = 0; c < 4; ++c) q[c] = g.orientation[0][c];
+        seen = true;
+        REQUIRE(crease::fold::sheet_frame(r.sheet(), f));
+      }
+      return false;
+    };
+    start_and_run_to(r, "fold/bend/follow_via[4]");
+    REQUIRE(seen);
+  };
+  const crease::fold::FoldSpec spec = crease::fold::load_fold_file(half_fixing_shift());
+  REQUIRE(spec.bend_yaw_limited);
+  const double* via3 = spec.via_orientation[3];
+  double q[4];
+  crease::fold::SheetFrame f;
+  via3_turn(half_fixing_shift(), q, f);
+  double expect[4];
+  crease::fold::turn_about_vertical(f, 8.0 * std::numbers::pi / 180.0, via3, expect);
+  const double sign = q[3] * expect[3] < 0 ? -1.0 : 1.0;
+  for (int c = 0; c < 4; ++c) CHECK(sign * q[c] == doctest::Approx(expect[c]).epsilon(1e-4));
+
+  // Failing variant: no range, the via point's own orientation in the turned sheet's frame.
+  std::string text;
+  {
+    std::ifstream in(half_fixing_shift());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  for (const std::string key : {"  yaw_reference_deg: 180\n", "  yaw_range_deg: [-10, 20]\n"}) {
+    const std::size_t k = text.find(key);
+    REQUIRE(k != std::string::npos);
+    text.erase(k, key.size());
+  }
+  const std::string unlimited = (std::filesystem::temp_directory_path() /
+                                 ("crease_half_unlimited_" + std::to_string(::getpid()) + ".yaml"))
+                                    .string();
+  std::ofstream(unlimited) << text;
+  double q0[4];
+  via3_turn(unlimited, q0, f);
+  for (int c = 0; c < 4; ++c) CHECK(q0[c] == doctest::Approx(via3[c]).epsilon(1e-9));
 }

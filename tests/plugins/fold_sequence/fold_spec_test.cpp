@@ -67,6 +67,10 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.fixate.fingers == 0x03);
   CHECK(h.fixate.approach_height_mm == 30.0);
   CHECK(h.lay_mm[1] == 14.5);
+  CHECK(h.bend_yaw_limited);  // bend.yaw_range_deg: the pad's turn with the sheet's heading
+  CHECK(h.bend_yaw_reference_deg == 180.0);
+  CHECK(h.bend_yaw_range_deg[0] == -10.0);
+  CHECK(h.bend_yaw_range_deg[1] == 20.0);
   CHECK(h.lay_mm[2] == -22.0);
   CHECK(h.refixate_out_mm[0] == 255.0);
   CHECK(h.refixate_out_force_n == 0.5);
@@ -126,6 +130,15 @@ TEST_CASE("malformed sequence files name the file, the line and the key") {
     const std::string e = error_of(variant("  force_n: 1.5", "  forse_n: 1.5"));
     CHECK(e.find(tmp + ":" + std::to_string(line) + ":") == 0);
     CHECK(e.find("fold.shift.forse_n: unknown key") != std::string::npos);
+  }
+  SUBCASE("a yaw range that does not hold the drawn heading, or one without its reference") {
+    const int line = line_of("  yaw_range_deg: [-10, 20]");
+    const std::string e =
+        error_of(variant("  yaw_range_deg: [-10, 20]", "  yaw_range_deg: [5, 20]"));
+    CHECK(e.find(tmp + ":" + std::to_string(line) + ":") == 0);
+    CHECK(e.find("fold.bend.yaw_range_deg") != std::string::npos);
+    const std::string r = error_of(variant("  yaw_reference_deg: 180\n", ""));
+    CHECK(r.find("fold.bend.yaw_reference_deg") != std::string::npos);
   }
   SUBCASE("a missing required key") {
     const std::string e = error_of(variant("  corner_mm: [105, 297]", ""));

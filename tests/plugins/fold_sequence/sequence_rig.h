@@ -133,9 +133,10 @@ class Rig {
   }
 
   // The flat sheet, 3 x 3 nodes, corner (0, 0) at world (x0, y0), u along +x, v along -y
-  // (TURNED: u along -x, v along +y).
-  void place_sheet(double x0, double y0, bool turned) {
+  // (TURNED: u along -x, v along +y), then turned YAW rad about the vertical through that corner.
+  void place_sheet(double x0, double y0, bool turned, double yaw = 0.0) {
     const double sign = turned ? -1.0 : 1.0;
+    const double c = std::cos(yaw), sn = std::sin(yaw);
     SheetState& s = *sheet_;
     s.nodes_u = 3;
     s.nodes_v = 3;
@@ -144,8 +145,9 @@ class Rig {
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) {
         float* p = s.position_mm[j * 3 + i];
-        p[0] = static_cast<float>(x0 + sign * 105.0 * i);
-        p[1] = static_cast<float>(y0 - sign * 148.5 * j);
+        const double dx = sign * 105.0 * i, dy = -sign * 148.5 * j;
+        p[0] = static_cast<float>(x0 + c * dx - sn * dy);
+        p[1] = static_cast<float>(y0 + sn * dx + c * dy);
         p[2] = 0;
         s.normal[j * 3 + i][2] = -1;
         for (int c = 0; c < 3; ++c) flat_[j * 3 + i][c] = p[c];

@@ -160,3 +160,30 @@ TEST_CASE("sheet_to_world: a sheet pose in the world, the inverse of world_to_sh
   const double z_down = 1.0 - 2.0 * (qw[0] * qw[0] + qw[1] * qw[1]);  // R(q)'s zz
   CHECK(z_down == doctest::Approx(-1.0));
 }
+
+TEST_CASE(
+    "frame_yaw is the heading of u; turn_about_vertical turns a sheet-frame pose about the world's "
+    "z") {
+  const double yaw = std::numbers::pi + 0.2;
+  const auto s = sheet(3, 3, 105, -148.5, yaw);
+  SheetFrame f;
+  REQUIRE(sheet_frame(*s, f));
+  CHECK(std::remainder(frame_yaw(f) - yaw, 2 * std::numbers::pi) ==
+        doctest::Approx(0.0).epsilon(1e-6));
+  // Turning a pose by -0.2 rad about the vertical in this frame is the same world pose as that
+  // pose in the frame of the sheet turned 0.2 rad less.
+  const auto s0 = sheet(3, 3, 105, -148.5, std::numbers::pi);
+  SheetFrame f0;
+  REQUIRE(sheet_frame(*s0, f0));
+  const double p[3] = {0, 0, 0}, q[4] = {-0.52423, 0.70760, -0.28017, -0.38208};
+  double turned[4], w1[3], q1[4], w0[3], q0[4];
+  turn_about_vertical(f, -0.2, q, turned);
+  sheet_to_world(f, p, turned, w1, q1);
+  sheet_to_world(f0, p, q, w0, q0);
+  const double sign = q1[3] * q0[3] < 0 ? -1.0 : 1.0;
+  for (int c = 0; c < 4; ++c) CHECK(sign * q1[c] == doctest::Approx(q0[c]).epsilon(1e-6));
+  // No turn: the same orientation.
+  double same[4];
+  turn_about_vertical(f, 0.0, q, same);
+  for (int c = 0; c < 4; ++c) CHECK(same[c] == doctest::Approx(q[c]).epsilon(1e-9));
+}
