@@ -39,7 +39,7 @@ void StrainLimit::project_rt(std::span<Vec3> x, std::span<const double> w,
     const double r = w[i] * h;  // the hold over the node's mass
     wl_[i] = w[i] > 0 ? w[i] / (1.0 + r) : 0.0;
     // Held: its hold outweighs its own mass kHeldRatio times over.
-    if (w[i] > 0 && h * w[i] >= kHeldRatio && n_held_ < static_cast<int>(held_.size()))
+    if (w[i] > 0 && r >= kHeldRatio && n_held_ < static_cast<int>(held_.size()))
       held_[static_cast<std::size_t>(n_held_++)] = static_cast<std::int32_t>(i);
   }
   // Tethers between held nodes: no further apart than their distance on the sheet allows.
