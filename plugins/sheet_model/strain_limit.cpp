@@ -4,6 +4,23 @@
 #include <cmath>
 
 namespace crease::sheet {
+namespace {
+
+// Nodes A and B no further apart than LIM (mm), each moved by its weight's share. False when
+// they were not (or nothing can move).
+bool limit_pair(std::span<Vec3> x, std::int32_t a, std::int32_t b, double lim, double wa,
+                double wb) noexcept {
+  const Vec3 d = x[b] - x[a];
+  const double len2 = dot(d, d);
+  if (len2 <= lim * lim || !(wa + wb > 0)) return false;
+  const double len = std::sqrt(len2);
+  const Vec3 corr = ((len - lim) / (len * (wa + wb))) * d;
+  x[a] += wa * corr;
+  x[b] -= wb * corr;
+  return true;
+}
+
+}  // namespace
 
 void StrainLimit::configure(const Topology& topo, std::span<const double> rest) {
   a_.clear();
@@ -50,15 +67,7 @@ void StrainLimit::project_rt(std::span<Vec3> x, std::span<const double> w,
       for (int q = p + 1; q < n_held_; ++q) {
         const std::int32_t b = held_[static_cast<std::size_t>(q)];
         const double du = uv_[b].u - uv_[a].u, dv = uv_[b].v - uv_[a].v;
-        const double lim = grow * std::sqrt(du * du + dv * dv);
-        const Vec3 d = x[b] - x[a];
-        const double len2 = dot(d, d);
-        if (len2 <= lim * lim) continue;
-        const double len = std::sqrt(len2);
-        const double wa = wl_[a], wb = wl_[b];
-        const Vec3 corr = ((len - lim) / (len * (wa + wb))) * d;
-        x[a] += wa * corr;
-        x[b] -= wb * corr;
+        (void)limit_pair(x, a, b, grow * std::sqrt(du * du + dv * dv), wl_[a], wl_[b]);
       }
     }
   }
@@ -67,19 +76,7 @@ void StrainLimit::project_rt(std::span<Vec3> x, std::span<const double> w,
     bool any = false;
     for (int q = 0; q < m; ++q) {
       const int k = (s % 2 == 0) ? q : m - 1 - q;
-      const std::int32_t a = a_[k], b = b_[k];
-      const Vec3 d = x[b] - x[a];
-      const double len2 = dot(d, d);
-      const double lim = max_len_[k];
-      if (len2 <= lim * lim) continue;
-      const double len = std::sqrt(len2);
-      const double wa = wl_[a], wb = wl_[b];
-      const double den = wa + wb;
-      if (!(den > 0)) continue;
-      const Vec3 corr = ((len - lim) / (len * den)) * d;
-      x[a] += wa * corr;
-      x[b] -= wb * corr;
-      any = true;
+      if (limit_pair(x, a_[k], b_[k], max_len_[k], wl_[a_[k]], wl_[b_[k]])) any = true;
     }
     if (!any) break;
   }

@@ -43,7 +43,9 @@ class StrainLimit {
   [[nodiscard]] int held_count() const noexcept { return n_held_; }
 
   static constexpr double kHeldRatio = 100.0;  // held: hold >= this x the node's mass
-  static constexpr int kMaxHeld = 256;  // tethered held nodes per substep (the rest: links only)
+  // Tethered held nodes per substep (the rest: links only); their pairs cost kMaxHeld^2 / 2 a
+  // sweep (a fingertip holds 2-10 of the world's nodes).
+  static constexpr int kMaxHeld = 64;
 
  private:
   std::vector<std::int32_t> a_, b_;

@@ -278,6 +278,39 @@ TEST_CASE("the arms' parked pose (sim_world's default): each index pad 300 mm ov
   }
 }
 
+namespace {
+
+// The pinching hand, shaped, from its parked pose (Q, set here and moved) through above_via to
+// above the edge (approach limits), then round the overhang to the pinch (contact limits), on
+// SHEET. VIA false: straight from the parked pose to above the edge. TURNED_FROM: above_via as a
+// point of that sheet frame, turning with the sheet (else the world pose half.yaml gives).
+// Returns how many points are not reached.
+int grasp_failures(ArmIk& ik, ArmIk::Joints& q, const fold::FoldSpec& f, const KDL::Frame& sheet,
+                   bool via = true, const KDL::Frame* turned_from = nullptr) {
+  q = parked(pinching(f));
+  REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.grasp_tool), q, posture(f.prepinch_rad)));
+  std::vector<KDL::Frame> to_above;
+  for (int k = 0; k < f.grasp_above_via_count && via; ++k) {
+    const double* p = f.grasp_above_via_mm[k];
+    const double* r = f.grasp_above_via_orientation[k];
+    REQUIRE(f.grasp_above_via_world[k]);
+    const KDL::Frame world(KDL::Rotation::Quaternion(r[0], r[1], r[2], r[3]),
+                           KDL::Vector(p[0], p[1], p[2]) / 1000.0);
+    to_above.push_back(turned_from != nullptr ? sheet * (turned_from->Inverse() * world) : world);
+  }
+  const KDL::Frame above = sheet_goal(sheet, f.grasp_above_mm, f.grasp_orientation);
+  to_above.push_back(above);
+  const int missed = path_failures(ik, q, ik.tool_pose(q), to_above, f.approach, "grasp above");
+  if (missed > 0) return missed + f.grasp_path_count + 1;
+  std::vector<KDL::Frame> path;
+  for (int k = 0; k < f.grasp_path_count; ++k)
+    path.push_back(sheet_goal(sheet, f.grasp_path_mm[k], f.grasp_orientation));
+  path.push_back(sheet_goal(sheet, f.grasp_at_mm, f.grasp_orientation));
+  return path_failures(ik, q, above, path, f.contact, "grasp reach");
+}
+
+}  // namespace
+
 TEST_CASE(
     "from the parked pose, the pinching arm's grasp of the half fold passes arm_motion's path "
     "check, at every yaw the world draws") {
@@ -294,26 +327,8 @@ TEST_CASE(
   KDL::Frame sheet = nominal;
   auto grasp = [&](bool via, bool turned = false) {
     ArmIk ik(m, pinching(f));
-    ArmIk::Joints q = parked(pinching(f));
-    REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.grasp_tool), q, posture(f.prepinch_rad)));
-    std::vector<KDL::Frame> to_above;
-    for (int k = 0; k < f.grasp_above_via_count && via; ++k) {
-      const double* p = f.grasp_above_via_mm[k];
-      const double* r = f.grasp_above_via_orientation[k];
-      REQUIRE(f.grasp_above_via_world[k]);
-      const KDL::Frame world(KDL::Rotation::Quaternion(r[0], r[1], r[2], r[3]),
-                             KDL::Vector(p[0], p[1], p[2]) / 1000.0);
-      to_above.push_back(turned ? sheet * (nominal.Inverse() * world) : world);
-    }
-    const KDL::Frame above = sheet_goal(sheet, f.grasp_above_mm, f.grasp_orientation);
-    to_above.push_back(above);
-    const int missed = path_failures(ik, q, ik.tool_pose(q), to_above, f.approach, "grasp above");
-    if (missed > 0) return missed + f.grasp_path_count + 1;
-    std::vector<KDL::Frame> path;
-    for (int k = 0; k < f.grasp_path_count; ++k)
-      path.push_back(sheet_goal(sheet, f.grasp_path_mm[k], f.grasp_orientation));
-    path.push_back(sheet_goal(sheet, f.grasp_at_mm, f.grasp_orientation));
-    return path_failures(ik, q, above, path, f.contact, "grasp reach");
+    ArmIk::Joints q{};
+    return grasp_failures(ik, q, f, sheet, via, turned ? &nominal : nullptr);
   };
   CHECK(grasp(true) == 0);
   CHECK(grasp(false) > 0);  // failing variant: the straight turn
@@ -428,24 +443,8 @@ int bend_failures(const robot::RobotModel& m, const fold::FoldSpec& f, double ya
   const double yaw = yaw_deg * std::numbers::pi / 180.0;
   const KDL::Frame sheet = shifted_sheet(layout(), f, yaw);
   ArmIk ik(m, pinching(f));
-  ArmIk::Joints q = parked(pinching(f));
-  REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.grasp_tool), q, posture(f.prepinch_rad)));
-  std::vector<KDL::Frame> to_above;
-  for (int k = 0; k < f.grasp_above_via_count; ++k) {
-    const double* p = f.grasp_above_via_mm[k];
-    const double* r = f.grasp_above_via_orientation[k];
-    REQUIRE(f.grasp_above_via_world[k]);
-    to_above.push_back(KDL::Frame(KDL::Rotation::Quaternion(r[0], r[1], r[2], r[3]),
-                                  KDL::Vector(p[0], p[1], p[2]) / 1000.0));
-  }
-  const KDL::Frame above = sheet_goal(sheet, f.grasp_above_mm, f.grasp_orientation);
-  to_above.push_back(above);
-  REQUIRE(path_failures(ik, q, ik.tool_pose(q), to_above, f.approach, "grasp above") == 0);
-  std::vector<KDL::Frame> path;
-  for (int k = 0; k < f.grasp_path_count; ++k)
-    path.push_back(sheet_goal(sheet, f.grasp_path_mm[k], f.grasp_orientation));
-  path.push_back(sheet_goal(sheet, f.grasp_at_mm, f.grasp_orientation));
-  REQUIRE(path_failures(ik, q, above, path, f.contact, "grasp reach") == 0);
+  ArmIk::Joints q{};
+  REQUIRE(grasp_failures(ik, q, f, sheet) == 0);
   REQUIRE(ik.set_tool(static_cast<ToolFrame>(f.grasp_tool), q, posture(f.pinch_rad)));
   const KDL::Frame from = ik.tool_pose(q);
   const KDL::Rotation pinched = sheet.M.Inverse() * from.M;  // the pinched pad in the sheet frame

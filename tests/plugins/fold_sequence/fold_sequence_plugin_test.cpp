@@ -1041,22 +1041,10 @@ TEST_CASE("the bend's pad turns with the sheet's heading only within the fold fi
   for (int c = 0; c < 4; ++c) CHECK(sign * q[c] == doctest::Approx(expect[c]).epsilon(1e-4));
 
   // Failing variant: no range, the via point's own orientation in the turned sheet's frame.
-  std::string text;
-  {
-    std::ifstream in(half_fixing_shift());
-    std::stringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
-  for (const std::string key : {"  yaw_reference_deg: 180\n", "  yaw_range_deg: [-10, 20]\n"}) {
-    const std::size_t k = text.find(key);
-    REQUIRE(k != std::string::npos);
-    text.erase(k, key.size());
-  }
-  const std::string unlimited = (std::filesystem::temp_directory_path() /
-                                 ("crease_half_unlimited_" + std::to_string(::getpid()) + ".yaml"))
-                                    .string();
-  std::ofstream(unlimited) << text;
+  std::string text = read_fold_text(half_fixing_shift());
+  for (const std::string key : {"  yaw_reference_deg: 180\n", "  yaw_range_deg: [-10, 20]\n"})
+    replace_once(text, key, "");
+  const std::string unlimited = write_fold_text(text, "crease_half_unlimited");
   double q0[4];
   via3_turn(unlimited, q0, f);
   for (int c = 0; c < 4; ++c) CHECK(q0[c] == doctest::Approx(via3[c]).epsilon(1e-9));

@@ -41,32 +41,41 @@ inline constexpr int kLeft = 1;
 
 inline std::string fold_file(const char* name) { return std::string(CREASE_SOURCE_DIR) + "/config/folds/" + name; }
 
+// A fold file's text, edited, written to a temporary file of its own (NAME, this process's pid
+// appended): its path.
+inline std::string read_fold_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+inline void replace_once(std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t k = text.find(from);
+  REQUIRE_MESSAGE(k != std::string::npos, "the fold file no longer has '" << from << "'");
+  text.replace(k, from.size(), to);
+}
+inline std::string write_fold_text(const std::string& text, const std::string& name) {
+  const std::string out =
+      (std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".yaml"))
+          .string();
+  std::ofstream(out) << text;
+  return out;
+}
+
 // The shipped half fold with its fixing hand shifting the sheet (shift.hand: fixing, pressing where
 // it then fixates): the machine's one-hand shift, which most tests here walk. The shipped file
 // (the pinching hand shifts, then lets go; the fixing hand comes down) has its own test.
 inline std::string half_fixing_shift() {
   static const std::string path = [] {
-    std::ifstream in(fold_file("half.yaml"));
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string s = text.str();
-    for (const auto& [from, to] :
-         {std::pair<std::string, std::string>{"  hand: pinching\n", "  hand: fixing\n"},
-          {"  at_mm: [105, 88.5]", "  at_mm: [165, 88.5]"}}) {
-      const std::size_t k = s.find(from);
-      REQUIRE_MESSAGE(k != std::string::npos, "half.yaml no longer has '" << from << "'");
-      s.replace(k, from.size(), to);
-    }
+    std::string s = read_fold_text(fold_file("half.yaml"));
+    replace_once(s, "  hand: pinching\n", "  hand: fixing\n");
+    replace_once(s, "  at_mm: [105, 88.5]", "  at_mm: [165, 88.5]");
     const std::size_t f0 = s.find("  fixate: {"),
                       f1 = s.find("}\n", f0);  // grasp.fixate: the shift's contact instead
     REQUIRE_MESSAGE((f0 != std::string::npos && f1 != std::string::npos),
                     "half.yaml no longer has grasp.fixate");
     s.erase(f0, f1 + 2 - f0);
-    const std::string out = (std::filesystem::temp_directory_path() /
-                             ("crease_half_fixing_shift_" + std::to_string(::getpid()) + ".yaml"))
-                                .string();
-    std::ofstream(out) << s;
-    return out;
+    return write_fold_text(s, "crease_half_fixing_shift");
   }();
   return path;
 }
