@@ -38,7 +38,10 @@ void StrainLimit::configure(const Topology& topo, std::span<const double> rest) 
   for (int i = 0; i < topo.grid.count(); ++i)
     uv_[static_cast<std::size_t>(i)] = topo.grid.sheet_of(i);
   held_.assign(kMaxHeld, 0);
+  anchors_.assign(kMaxAnchors, 0);
+  is_held_.assign(static_cast<std::size_t>(topo.grid.count()), 0);
   n_held_ = 0;
+  n_anchors_ = 0;
   prepared_strain_ = -1;
 }
 
@@ -56,9 +59,11 @@ void StrainLimit::project_rt(std::span<Vec3> x, std::span<const double> w,
     const double r = w[i] * h;  // the hold over the node's mass
     wl_[i] = w[i] > 0 ? w[i] / (1.0 + r) : 0.0;
     // Held: its hold outweighs its own mass kHeldRatio times over.
-    if (w[i] > 0 && r >= kHeldRatio && n_held_ < static_cast<int>(held_.size()))
-      held_[static_cast<std::size_t>(n_held_++)] = static_cast<std::int32_t>(i);
+    const bool held = w[i] > 0 && r >= kHeldRatio && n_held_ < static_cast<int>(held_.size());
+    is_held_[i] = held ? 1 : 0;
+    if (held) held_[static_cast<std::size_t>(n_held_++)] = static_cast<std::int32_t>(i);
   }
+  pick_anchors();
   // Tethers between held nodes: no further apart than their distance on the sheet allows.
   const double grow = 1.0 + max_strain;
   for (int s = 0; s < sweeps; ++s) {
@@ -71,6 +76,7 @@ void StrainLimit::project_rt(std::span<Vec3> x, std::span<const double> w,
       }
     }
   }
+  if (n_anchors_ > 0) tether_to_anchors(x, n, grow);
   const int m = link_count();
   for (int s = 0; s < sweeps; ++s) {
     bool any = false;
@@ -79,6 +85,42 @@ void StrainLimit::project_rt(std::span<Vec3> x, std::span<const double> w,
       if (limit_pair(x, a_[k], b_[k], max_len_[k], wl_[a_[k]], wl_[b_[k]])) any = true;
     }
     if (!any) break;
+  }
+}
+
+void StrainLimit::pick_anchors() noexcept {
+  n_anchors_ = 0;
+  const double spacing2 = kAnchorSpacingMm * kAnchorSpacingMm;
+  for (int p = 0; p < n_held_ && n_anchors_ < kMaxAnchors; ++p) {
+    const Vec2 h = uv_[static_cast<std::size_t>(held_[static_cast<std::size_t>(p)])];
+    bool apart = true;
+    for (int q = 0; q < n_anchors_ && apart; ++q) {
+      const Vec2 a = uv_[static_cast<std::size_t>(anchors_[static_cast<std::size_t>(q)])];
+      apart = (h.u - a.u) * (h.u - a.u) + (h.v - a.v) * (h.v - a.v) >= spacing2;
+    }
+    if (apart)
+      anchors_[static_cast<std::size_t>(n_anchors_++)] = held_[static_cast<std::size_t>(p)];
+  }
+}
+
+void StrainLimit::tether_to_anchors(std::span<Vec3> x, std::size_t n, double grow) noexcept {
+  const double grow2 = grow * grow;
+  for (int q = 0; q < n_anchors_; ++q) {
+    const auto a = static_cast<std::size_t>(anchors_[static_cast<std::size_t>(q)]);
+    const Vec3 xa = x[a];
+    const Vec2 ua = uv_[a];
+    for (std::size_t i = 0; i < n; ++i) {
+      if (is_held_[i] != 0 || !(wl_[i] > 0)) continue;  // held nodes: the pairwise tethers
+      const Vec3 d = x[i] - xa;
+      const double len2 = dot(d, d);
+      const double du = uv_[i].u - ua.u, dv = uv_[i].v - ua.v;
+      const double lim2 = grow2 * (du * du + dv * dv);
+      if (len2 <= lim2) continue;
+      const double len = std::sqrt(len2);
+      // Towards the sphere about the anchor, at most kAnchorStepMm: the straight line may cross
+      // what the paper wraps round (the table's edge), whose contacts push back only so far.
+      x[i] -= (std::min(len - std::sqrt(lim2), kAnchorStepMm) / len) * d;
+    }
   }
 }
 
