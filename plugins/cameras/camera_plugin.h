@@ -65,6 +65,14 @@ class CameraPlugin : public crease::Plugin {
     return crease::Status::fault;
   }
 
+  // RT: logs (with the running count) when a live source's reconnect count N moved since the
+  // last call.
+  void log_reconnects_rt(std::uint64_t n, const char* what) noexcept {
+    if (n == reported_reconnects_) return;
+    reported_reconnects_ = n;
+    log_rt(crease::rt::LogLevel::info, what, static_cast<std::int64_t>(n));
+  }
+
   // Non-RT, after a fault too: says why the worker stopped, if it did.
   void deactivate() override {
     if (worker_ && !worker_->error().empty())
@@ -80,6 +88,7 @@ class CameraPlugin : public crease::Plugin {
                         std::unique_ptr<CameraSource> source, bool lockstep_default = true,
                         const char* images_port = kImagesPort, const char* frames_port = "frames") {
     lockstep_ = p.get<bool>("lockstep", lockstep_default);
+    reported_reconnects_ = 0;
     stale_cycles_ = p.get_in_range<int>("stale_cycles", 10, 1, 100000);
     const std::string record = p.has("record") ? p.get_path("record") : std::string();
     // The replay layouts: one grey image per camera, or an RGB-D camera's depth and colour.
@@ -103,6 +112,7 @@ class CameraPlugin : public crease::Plugin {
   bool lockstep_ = false;
   int stale_cycles_ = 10;
   int since_fresh_ = 0;
+  std::uint64_t reported_reconnects_ = 0;
 };
 
 }  // namespace crease::vision

@@ -42,17 +42,12 @@ class CameraV4l2Plugin final : public CameraPlugin {
     const V4l2Source* source = src.get();
     configure_camera(p, ports, std::move(src));
     source_ = source;  // owned by the worker, which lives until cleanup()
-    reported_reconnects_ = 0;
   }
 
   crease::Status update(const crease::Cycle& cycle) override {
     const crease::Status s = CameraPlugin::update(cycle);
-    const std::uint64_t n = source_->reconnects();  // an atomic the capture worker counts
-    if (n != reported_reconnects_) {
-      reported_reconnects_ = n;
-      log_rt(crease::rt::LogLevel::info, "camera reconnected; reconnects so far",
-             static_cast<std::int64_t>(n));
-    }
+    log_reconnects_rt(source_->reconnects(),
+                      "camera reconnected; reconnects so far");  // an atomic the worker counts
     return s;
   }
 
@@ -68,7 +63,6 @@ class CameraV4l2Plugin final : public CameraPlugin {
  private:
   const V4l2Source* source_ = nullptr;
   std::vector<std::string> devices_;
-  std::uint64_t reported_reconnects_ = 0;
 };
 
 }  // namespace
