@@ -16,7 +16,8 @@
 //   crease-bench world [--quick] [--ours-only] [--mj-solver CG|PGS|Newton] [--mj-iterations N]
 //   [--cpu K]
 // --quick: press_drag's first 1.7 simulated seconds (descent and press) only.
-// --ours-only: MuJoCo not run (to profile ours); the last line then carries ours alone.
+// --ours-only: MuJoCo not run (to profile ours); ours' end states are printed, the last line
+// carries ours alone.
 // Last line: world: ours_rtf=... mujoco_rtf=... ratio=... drag_mm=ours/mujoco pinch_rise_mm=...
 // pinch_slip_mm=... fold_slip_mm=... fold_edges_mm=... retained_deg=...
 #include <pthread.h>
@@ -236,9 +237,13 @@ int run_world(int argc, char** argv) {
     std::vector<MirroredShape> mirror;
     double table_mu = 0;
     const SheetRun ours = run_ours(model, sc, mirror, table_mu);
-    if (ours_only) {
+    if (ours_only) {  // ours' end state alone
       ours_wall += ours.wall_s;
       simulated += ours.simulated_s;
+      const std::vector<double> f = scene_figures(sc, ours, mirror);
+      const std::vector<std::string> names = figure_names(sc);
+      for (std::size_t i = 0; i < names.size(); ++i)
+        std::printf("  %-52s %9.2f\n", names[i].c_str(), f[i]);
       continue;
     }
     SheetRun theirs;
