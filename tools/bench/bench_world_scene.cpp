@@ -185,7 +185,10 @@ bool fold_script(const robot::RobotModel& model, Script& out) {
   const Vec3 at{0, 134, -1.2};  // the index pad under the far edge's middle, 14.5 mm inside it
   std::array<Path, 2> p{Path{{{0, 190, 40}}, {pinch_hand(0.0)}, {palm0}},
                         Path{{{-60, -60, 8}}, {index_out()}, {}}};
-  p[1].line({-60, -60, -6}, 10.0, dt);  // presses the near half (index_out: ~0.8 N)
+  // Presses the near half 10 mm into the table (index_out): at 6 mm, since the table's edges were
+  // rounded, the bend dragged the near half 52.9 mm and the fold was lost (the square far edge had
+  // caught the paper and held the sheet with the index).
+  p[1].line({-60, -60, -10}, 10.0, dt);
   p[0].hold(0.3, dt);
   p[0].line({0, 190, -35}, 40.0, dt);  // round the drooping overhang: down beyond it, in, up
   p[0].line({0, 134, -35}, 40.0, dt);
