@@ -109,7 +109,7 @@ inline constexpr int kArmMotionReasons = static_cast<int>(ArmMotionReason::count
 
 struct ArmMotionStatus {
   static constexpr char kPortType[] = "crease.ArmMotionStatus";
-  static constexpr std::uint32_t kPortVersion = 1;
+  static constexpr std::uint32_t kPortVersion = 2;  // 2: tool_mm, tool_measured
   static constexpr int kReasons = 20;
   enum State : std::uint8_t {
     idle = 0,            // holding the last command, no goal yet
@@ -131,22 +131,27 @@ struct ArmMotionStatus {
   std::uint8_t tool = 0;
   std::uint8_t segment = 0;    // the path segment running (0: towards the first point)
   std::uint8_t last_refusal = 0;  // ArmMotionReason of the last refused goal
+  std::uint8_t tool_measured = 0;  // 1: tool_mm holds this cycle's measured tool position
   float progress = 0;          // 0..1 along the whole path (by segments' parameter)
   float speed_mm_s = 0;        // the commanded tool frame's speed now
   float distance_to_go_mm = 0; // to the target along the path
   float ik_error_mm = 0;       // the IK's residual at this cycle's command
+  // Where the tool frame (`tool`: the last goal's) is, world mm: forward kinematics of the arm's
+  // joint readings this cycle (the hand's fingers as at that goal). Valid when tool_measured.
+  float tool_mm[3] = {};
   std::uint32_t goals_accepted = 0;
   std::uint32_t goals_refused = 0;
   std::uint32_t motions_aborted = 0;
   std::uint32_t reasons[kReasons] = {};  // per ArmMotionReason: how often it refused or aborted
 
   [[nodiscard]] bool all_finite() const {
-    return std::isfinite(progress) && std::isfinite(speed_mm_s) && std::isfinite(distance_to_go_mm) &&
-           std::isfinite(ik_error_mm);
+    return std::isfinite(progress) && std::isfinite(speed_mm_s) &&
+           std::isfinite(distance_to_go_mm) && std::isfinite(ik_error_mm) &&
+           std::isfinite(tool_mm[0]) && std::isfinite(tool_mm[1]) && std::isfinite(tool_mm[2]);
   }
 };
 static_assert(kArmMotionReasons <= ArmMotionStatus::kReasons, "one counter per reason");
 
-CREASE_PORT_PAYLOAD_LAYOUT(ArmMotionStatus, 136, 8);
+CREASE_PORT_PAYLOAD_LAYOUT(ArmMotionStatus, 144, 8);
 
 }  // namespace crease

@@ -380,6 +380,15 @@ void ArmMotion::publish(const CycleInputs& in) noexcept {
   }
   st.speed_mm_s = moving ? static_cast<float>(1000.0 * speed_m_s_) : 0.0f;
   st.ik_error_mm = static_cast<float>(1000.0 * ik_error_m_);
+  // The tool where the arm's readings put it (one forward kinematics a cycle).
+  st.tool_measured = 0;
+  if (in.arm != nullptr && in.arm->all_finite()) {
+    double q[kArmJoints];
+    for (int j = 0; j < kArmJoints; ++j) q[j] = in.arm->position_rad[j];
+    const KDL::Frame f = ik_.tool_pose(std::span<const double, kArmJoints>(q, kArmJoints));
+    for (int a = 0; a < 3; ++a) st.tool_mm[a] = static_cast<float>(1000.0 * f.p(a));
+    st.tool_measured = 1;
+  }
 }
 
 std::size_t ArmMotion::save_state(std::span<std::byte> out) const noexcept {

@@ -388,4 +388,21 @@ Reason Machine::grasp_off(const SheetState& sh, bool& judged) const noexcept {
   return d > spec_.pinch_lost_mm ? Reason::pinch_lost : Reason::none;
 }
 
+bool Machine::grasp_target(const Sensing& in, double world_mm[3],
+                           double sheet_mm[2]) const noexcept {
+  const S leaf = m_.leaf;
+  // The pinch holds the layer from the bend's first via point until the swipe releases it (the
+  // refixation moves the fixing hand only).
+  const bool holding =
+      leaf == S::follow_via || is_within(leaf, S::fixate_layer) || is_within(leaf, S::refixate);
+  const ArmMotionStatus* a = in.arm[kPinching];
+  if (!holding || a == nullptr || a->tool_measured == 0 || a->tool != spec_.grasp_tool ||
+      !a->all_finite())
+    return false;
+  for (int c = 0; c < 3; ++c) world_mm[c] = a->tool_mm[c];
+  sheet_mm[0] = spec_.grasp_at_mm[0];
+  sheet_mm[1] = spec_.grasp_at_mm[1];
+  return true;
+}
+
 }  // namespace crease::fold

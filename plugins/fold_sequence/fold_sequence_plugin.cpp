@@ -30,6 +30,10 @@ void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
   crease_ = ports.queue_output<SheetCreaseEvent>("sheet_crease");
   memorize_ = ports.queue_output<SheetMemorizeEvent>("sheet_memorize");
   status_ = ports.latest_output<SequenceStatus>("sequence_status", SequenceStatus{});
+  target_value_ = std::make_unique<TargetPoints>();
+  target_ = ports.latest_output<TargetPoints>("target_points", *target_value_);
+  target_written_ns_ = 0;
+  target_on_ = false;
 }
 
 void FoldSequencePlugin::activate() { started_ = false; }
@@ -78,6 +82,7 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   if (lost) machine_->fail(Reason::command_lost);
   log_retreat(out);
 
+  write_grasp_target(in, c.time_ns);
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);
   if (status_value_.transitions != logged_transitions_) {
@@ -96,6 +101,23 @@ Status FoldSequencePlugin::update(const Cycle& c) {
     log_rt(rt::LogLevel::mark, text);
   }
   return status_value_.phase == SequenceStatus::aborted ? Status::degraded : Status::ok;
+}
+
+void FoldSequencePlugin::write_grasp_target(const Sensing& in, std::int64_t now_ns) noexcept {
+  double world[3], sheet[2];
+  const bool on = machine_->grasp_target(in, world, sheet);
+  if (!on && !target_on_) return;
+  if (on && target_on_ && now_ns - target_written_ns_ < kTargetPeriodNs) return;
+  TargetPoints& t = *target_value_;
+  t.timestamp_ns = now_ns;
+  t.count = on ? 1 : 0;
+  if (on) {
+    for (int c = 0; c < 3; ++c) t.points[0].world_mm[c] = static_cast<float>(world[c]);
+    for (int c = 0; c < 2; ++c) t.points[0].sheet_mm[c] = static_cast<float>(sheet[c]);
+  }
+  target_.write(t, now_ns);
+  target_written_ns_ = now_ns;
+  target_on_ = on;
 }
 
 void FoldSequencePlugin::log_retreat(const Outbox& out) const noexcept {

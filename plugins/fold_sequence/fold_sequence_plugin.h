@@ -7,13 +7,19 @@
 //   arm_r_status, arm_l_status    latest in   crease::ArmMotionStatus  (arm_motion per arm)
 //   hand_r_status, hand_l_status  latest in   crease::HandControlStatus (force_controller per hand)
 //   contact_r_state, contact_l_state latest in crease::ContactState   (contact_controller per hand)
-//   sheet_state                   latest in   crease::SheetState (the model's: 164 kB, copied at most
+//   sheet_state                   latest in   crease::SheetState (the model's: 164 kB, copied at
+//   most
 //                                             every sheet_poll_ms, and only while folding)
 //   arm_r_goal, arm_l_goal        queue out   crease::ArmGoal
 //   hand_r_goal, hand_l_goal      queue out   crease::HandGoal
 //   sheet_crease                  queue out   crease::SheetCreaseEvent
 //   sheet_memorize                queue out   crease::SheetMemorizeEvent
 //   sequence_status               latest out  crease::SequenceStatus (creasectl status shows it)
+//   target_points                 latest out  crease::TargetPoints: while the pinch holds the
+//   sheet,
+//                                             one target, the grasp point where the pinching arm's
+//                                             readings put the tool (Machine::grasp_target), every
+//                                             kTargetPeriodNs; none (count 0) once it lets go
 // Parameters: fold (path of a sequence file, required), auto_start (false), sheet_poll_ms (200;
 // must stay below the file's sheet_max_age_s less the model's period). Tunable `command`
 // (0..5, integers): 1 start, 2 pause, 3 resume, 4 abort, 5 step; read once and reset to 0 by
@@ -27,6 +33,7 @@
 
 #include "core/plugin.h"
 #include "core/port.h"
+#include "core/port_types/sheet_state.h"
 #include "plugins/fold_sequence/fold_spec.h"
 #include "plugins/fold_sequence/machine.h"
 
@@ -51,6 +58,7 @@ class FoldSequencePlugin final : public Plugin {
  private:
   // RT. Logs what the abort's retreat did this cycle (Outbox's retried, joints_park, gave_up).
   void log_retreat(const Outbox& out) const noexcept;
+  void write_grasp_target(const Sensing& in, std::int64_t now_ns) noexcept;
   FoldSpec spec_;
   std::unique_ptr<Machine> machine_;
   std::unique_ptr<Outbox> outbox_;
@@ -69,6 +77,11 @@ class FoldSequencePlugin final : public Plugin {
   QueueOutput<SheetCreaseEvent> crease_;
   QueueOutput<SheetMemorizeEvent> memorize_;
   LatestOutput<SequenceStatus> status_;
+  LatestOutput<TargetPoints> target_;
+  std::unique_ptr<TargetPoints> target_value_;  // 20 kB: not on the stack
+  std::int64_t target_written_ns_ = 0;
+  bool target_on_ = false;
+  static constexpr std::int64_t kTargetPeriodNs = 10'000'000;  // 100 Hz: the model runs at 60
   SequenceStatus status_value_{};
 };
 

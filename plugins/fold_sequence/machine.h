@@ -178,6 +178,13 @@ class Machine {
   // RT. The status port's value now.
   void fill_status(SequenceStatus& s, std::int64_t now_ns) const noexcept;
   [[nodiscard]] SequenceStatus::Phase phase() const noexcept;
+  // RT. While the pinch holds the sheet (the bend from the pinch on, the lay, the refixation):
+  // the grasp point (sheet mm, the fold file's grasp_at_mm) and where the pinching arm's readings
+  // put the pinching tool (world mm, arm_motion's status). The model takes it as a target
+  // (`target_points`): the robot knows where its fingers hold the sheet when the hand hides the
+  // flap's markers from the cameras, or the fold turns them away. False otherwise.
+  [[nodiscard]] bool grasp_target(const Sensing& in, double world_mm[3],
+                                  double sheet_mm[2]) const noexcept;
 
  private:
   // machine.cpp: the engine.

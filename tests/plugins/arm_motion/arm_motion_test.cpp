@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,37 @@ TEST_CASE("a motion reaches its target within the goal's limits; its final comma
   }
   for (float v : r.last.velocity_rad_s) CHECK(v == 0.0f);
   CHECK(r.motion->status().state == ArmMotionStatus::reached);
+}
+
+TEST_CASE(
+    "the status says where the tool is by the arm's readings, every cycle of a motion; not without "
+    "a reading") {
+  Rig r;
+  idle(r);
+  const KDL::Frame start = r.tool_pose_at(ToolFrame::ff_pad, q_cmd(r));
+  const ArmGoal g =
+      goal_to(ToolFrame::ff_pad, shifted(start, 60, 40, -30, KDL::Rotation::Identity()), 3);
+  REQUIRE(r.cycle(&g));
+  int n = 0;
+  double worst = 0, moved = 0;
+  while (r.active() && n++ < 20000) {
+    const Joints read = r.q_arm;  // what this cycle's arm_state reports (the last command)
+    r.cycle();
+    const ArmMotionStatus& st = r.motion->status();
+    REQUIRE(st.tool_measured == 1);
+    REQUIRE(st.tool == static_cast<std::uint8_t>(ToolFrame::ff_pad));
+    const KDL::Frame at = r.tool_pose_at(ToolFrame::ff_pad, read);  // robot_model's FK
+    const KDL::Vector got(st.tool_mm[0] / 1000.0, st.tool_mm[1] / 1000.0, st.tool_mm[2] / 1000.0);
+    worst = std::max(worst, mm(got - at.p));
+    moved = std::max(moved, mm(got - start.p));
+  }
+  CHECK(worst < 0.001);  // float mm
+  CHECK(moved > 70.0);   // it followed the motion (78 mm)
+  // No arm reading (a faulted state that is not finite): no position, the flag down.
+  r.arm_fresh = false;
+  r.q_arm[0] = std::numeric_limits<double>::quiet_NaN();
+  r.cycle();
+  CHECK(r.motion->status().tool_measured == 0);
 }
 
 TEST_CASE("via points are passed exactly, at rest, in order") {

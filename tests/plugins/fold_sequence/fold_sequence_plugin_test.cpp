@@ -552,6 +552,48 @@ TEST_CASE(
   CHECK(s.paths()[s.paths().size() - 1 - kRetreat.size()] == "fold/bend/follow_via[3]");
 }
 
+TEST_CASE(
+    "while the pinch holds the sheet the model gets one target: the grasp point where the pinching "
+    "arm's readings put the tool; none before the bend or once the fold aborts") {
+  Rig r;
+  auto targets = r.ports().latest_input<TargetPoints>("target_points");
+  const auto read = [&] {
+    (void)targets.poll();
+    return targets.has_value() ? targets.value() : TargetPoints{};
+  };
+  r.tool_at[kPin][0] = 12.5;
+  r.tool_at[kPin][1] = -3.0;
+  r.tool_at[kPin][2] = 88.0;
+  start_and_run_to(r, "fold/grasp/pinch");
+  CHECK(read().count == 0);  // nothing written before the bend
+  REQUIRE(r.run_to("fold/bend/follow_via[1]"));
+  r.run(30);
+  TargetPoints t = read();
+  REQUIRE(t.count == 1);
+  CHECK(t.points[0].world_mm[0] == 12.5f);
+  CHECK(t.points[0].world_mm[1] == -3.0f);
+  CHECK(t.points[0].world_mm[2] == 88.0f);
+  const crease::fold::FoldSpec spec = crease::fold::load_fold_file(r.fold_path());
+  CHECK(t.points[0].sheet_mm[0] == static_cast<float>(spec.grasp_at_mm[0]));
+  CHECK(t.points[0].sheet_mm[1] == static_cast<float>(spec.grasp_at_mm[1]));
+  // It follows the arm's readings (written every 10 ms).
+  r.tool_at[kPin][2] = 120.0;
+  r.run(15);
+  CHECK(read().points[0].world_mm[2] == 120.0f);
+  // Without a measured tool position (failing variant of the source): no target.
+  r.tool_measured = false;
+  r.run(15);
+  CHECK(read().count == 0);
+  r.tool_measured = true;
+  r.run(15);
+  CHECK(read().count == 1);
+  // An abort: the pinch opens, the target goes.
+  r.command(Command::abort);
+  r.run(50);
+  CHECK(std::string(r.status().path).rfind("abort", 0) == 0);
+  CHECK(read().count == 0);
+}
+
 TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {
   using crease::fold::Reason;
   SUBCASE("device fault: the arm's drive faults during a motion") {

@@ -235,6 +235,10 @@ class Rig {
     return out;
   }
 
+  // The rig's own end of the ports (a port the tests read), and the fold file it runs.
+  PortBinder& ports() { return rig_ports_; }
+  [[nodiscard]] const std::string& fold_path() const { return fold_; }
+
   // --- the scripted robot's knobs ---
   int move_cycles = 20;       // a motion runs this long, then reaches (or stops on contact)
   int settle_cycles = 15;     // a force goal settles after this
@@ -263,6 +267,9 @@ class Rig {
   // The pinch posture ends with th and ff squeezing (0.5 N each); false: the pads close on
   // nothing, though contact_state still names both (as a lagging ramp makes it do).
   bool pinch_feels = true;
+  // What each arm's status says of its tool's measured position (world mm).
+  bool tool_measured = true;
+  double tool_at[2][3] = {{10, 20, 30}, {-40, 50, 60}};
 
  private:
   struct Arm {
@@ -391,6 +398,9 @@ class Rig {
         }
       }
       a.st.timestamp_ns = h.st.timestamp_ns = contact_[s].timestamp_ns = now_;
+      a.st.tool = a.goal.tool;  // as arm_motion: the last goal's tool, where the readings put it
+      a.st.tool_measured = tool_measured ? 1 : 0;
+      for (int c = 0; c < 3; ++c) a.st.tool_mm[c] = static_cast<float>(tool_at[s][c]);
       arm_out_[s].write(a.st, now_);
       hand_out_[s].write(h.st, now_);
       contact_out_[s].write(contact_[s], now_);
