@@ -22,6 +22,7 @@
 #include "core/config/daemon_config.h"
 #include "core/daemon/daemon.h"
 #include "core/daemon/report_builder.h"
+#include "core/port_types/arm_goal.h"
 #include "core/port_types/sequence_status.h"
 #include "core/port_types/world_state.h"
 #include "rt/latest.h"
@@ -85,6 +86,7 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
   PluginHost& host = daemon.host();
   auto status = reader<SequenceStatus>(host, "fold.status");
   auto world = reader<WorldState>(host, "world_state");
+  auto motion_r = reader<ArmMotionStatus>(host, "arm_r.motion_status");
   host.start();
   test::SimLinkWatch links(host);
 
@@ -97,6 +99,9 @@ TEST_CASE("config/sim.yaml's folding sequence runs its first states against the 
     status.poll();
     links.poll();
   }
+  if (status.value().phase != SequenceStatus::running && motion_r.poll().has_data())
+    MESSAGE("not running: " << path_of(status.value()) << "; arm_r's last refusal: reason "
+                            << int(motion_r.value().last_refusal) << " (ArmMotionReason)");
   REQUIRE(status.value().phase == SequenceStatus::running);
   REQUIRE(world.poll().has_data());
   const Tips start = tips(world.value());
