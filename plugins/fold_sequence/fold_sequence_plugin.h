@@ -7,19 +7,19 @@
 //   arm_r_status, arm_l_status    latest in   crease::ArmMotionStatus  (arm_motion per arm)
 //   hand_r_status, hand_l_status  latest in   crease::HandControlStatus (force_controller per hand)
 //   contact_r_state, contact_l_state latest in crease::ContactState   (contact_controller per hand)
-//   sheet_state                   latest in   crease::SheetState (the model's: 164 kB, copied at
-//   most
-//                                             every sheet_poll_ms, and only while folding)
+//   sheet_state                   latest in   crease::SheetState (the model's: 164 kB, copied
+//                                             at most every sheet_poll_ms, and only while
+//                                             folding)
 //   arm_r_goal, arm_l_goal        queue out   crease::ArmGoal
 //   hand_r_goal, hand_l_goal      queue out   crease::HandGoal
 //   sheet_crease                  queue out   crease::SheetCreaseEvent
 //   sheet_memorize                queue out   crease::SheetMemorizeEvent
 //   sequence_status               latest out  crease::SequenceStatus (creasectl status shows it)
-//   target_points                 latest out  crease::TargetPoints: while the pinch holds the
-//   sheet,
-//                                             one target, the grasp point where the pinching arm's
-//                                             readings put the tool (Machine::grasp_target), every
-//                                             kTargetPeriodNs; none (count 0) once it lets go
+//   target_points                 latest out  crease::TargetPoints: while the pinch holds
+//                                             the sheet, one target, the grasp point where the
+//                                             pinching arm's readings put the tool
+//                                             (Machine::grasp_target), every kTargetPeriodNs;
+//                                             none (count 0) once it lets go
 // Parameters: fold (path of a sequence file, required), auto_start (false), sheet_poll_ms (200;
 // must stay below the file's sheet_max_age_s less the model's period). Tunable `command`
 // (0..5, integers): 1 start, 2 pause, 3 resume, 4 abort, 5 step; read once and reset to 0 by
