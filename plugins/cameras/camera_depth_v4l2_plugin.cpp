@@ -19,14 +19,6 @@ namespace {
 
 using namespace crease::vision;
 
-std::vector<std::string> device_list(const crease::Params& p, const char* key) {
-  std::vector<std::string> out;
-  const YAML::Node d = p.raw(key);
-  if (!d || !d.IsSequence()) p.fail(key, "expected a list of video devices");
-  for (const auto& n : d) out.push_back(p.resolve_path(n.as<std::string>()));
-  return out;
-}
-
 class CameraDepthV4l2Plugin final : public CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
@@ -36,8 +28,8 @@ class CameraDepthV4l2Plugin final : public CameraPlugin {
         p.fail("cameras", "cam" + std::to_string(k) +
                               ".yaml is a camera the robot carries (mount keys): its pose at each "
                               "capture is not read live yet");
-    const auto depth = device_list(p, "depth_devices");
-    const auto colour = device_list(p, "colour_devices");
+    const auto depth = read_device_list(p, "depth_devices");
+    const auto colour = read_device_list(p, "colour_devices");
     if (depth.size() != cams.size())
       p.fail("depth_devices", std::to_string(depth.size()) + " devices for " +
                                   std::to_string(cams.size()) + " calibrations");
@@ -47,11 +39,7 @@ class CameraDepthV4l2Plugin final : public CameraPlugin {
     if (cams.size() > V4l2DepthSource::kMaxCameras)
       p.fail("cameras", std::to_string(cams.size()) + " cameras, at most " +
                             std::to_string(V4l2DepthSource::kMaxCameras));
-    ReconnectPolicy retry;
-    retry.initial_s = p.get_in_range<double>("reconnect_initial_s", 0.5, 0.001, 60.0);
-    retry.max_s = p.get_in_range<double>("reconnect_max_s", 5.0, 0.001, 3600.0);
-    if (retry.max_s < retry.initial_s)
-      p.fail("reconnect_max_s", "must be at least reconnect_initial_s");
+    const ReconnectPolicy retry = read_reconnect_policy(p);
     const int wait_ms = p.get_in_range<int>("wait_ms", 100, 1, 1000);
     auto src = std::make_unique<V4l2DepthSource>(std::move(cams), depth, colour, retry, wait_ms);
     for (const std::string& why : src->failed())

@@ -22,14 +22,36 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/plugin.h"
 #include "core/port_types/camera_frames.h"
 #include "plugins/camera_rig/depth_camera.h"
 #include "plugins/camera_rig/images_port.h"
+#include "plugins/cameras/camera_source.h"
 #include "plugins/cameras/camera_worker.h"
 
 namespace crease::vision {
+
+// The live cameras' parameters (camera_v4l2, camera_depth_v4l2; non-RT, configure time).
+// KEY: a list of device paths, each resolved against the configuration's folder.
+inline std::vector<std::string> read_device_list(const crease::Params& p, const char* key) {
+  std::vector<std::string> out;
+  const YAML::Node d = p.raw(key);
+  if (!d || !d.IsSequence()) p.fail(key, "expected a list of video devices");
+  for (const auto& n : d) out.push_back(p.resolve_path(n.as<std::string>()));
+  return out;
+}
+// reconnect_initial_s (default 0.5) and reconnect_max_s (default 5), the latter at least the
+// former.
+inline ReconnectPolicy read_reconnect_policy(const crease::Params& p) {
+  ReconnectPolicy retry;
+  retry.initial_s = p.get_in_range<double>("reconnect_initial_s", 0.5, 0.001, 60.0);
+  retry.max_s = p.get_in_range<double>("reconnect_max_s", 5.0, 0.001, 3600.0);
+  if (retry.max_s < retry.initial_s)
+    p.fail("reconnect_max_s", "must be at least reconnect_initial_s");
+  return retry;
+}
 
 class CameraPlugin : public crease::Plugin {
  public:

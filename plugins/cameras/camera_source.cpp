@@ -34,6 +34,31 @@ namespace {
 std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
 }  // namespace
 
+void ReconnectClock::went_dark(const ReconnectPolicy& p, std::int64_t now_ns) noexcept {
+  backoff_s = p.initial_s;
+  retry_at_ns = now_ns + seconds_to_ns(backoff_s);
+}
+
+void ReconnectClock::failed_again(const ReconnectPolicy& p, std::int64_t now_ns) noexcept {
+  retry_at_ns = now_ns + seconds_to_ns(backoff_s);
+  backoff_s = std::min(2.0 * backoff_s, p.max_s);
+}
+
+bool open_capture(cv::VideoCapture& cap, const std::string& path, int width, int height) {
+  const bool node = path.rfind("/dev/", 0) == 0;
+  const bool sequence = path.find('%') != std::string::npos;
+  try {
+    cap.open(path, node ? cv::CAP_V4L2 : sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
+    if (cap.isOpened() && node) {
+      cap.set(cv::CAP_PROP_FRAME_WIDTH, width);
+      cap.set(cv::CAP_PROP_FRAME_HEIGHT, height);
+    }
+  } catch (const cv::Exception&) {
+    cap.release();  // unopenable now: retried later
+  }
+  return cap.isOpened();
+}
+
 V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::string>& devices,
                        ReconnectPolicy policy)
     : cameras_(std::move(cameras)), policy_(policy) {
@@ -62,21 +87,7 @@ V4l2Source::V4l2Source(std::vector<Camera> cameras, const std::vector<std::strin
 
 bool V4l2Source::try_open(std::size_t k) {
   Device& d = devices_[k];
-  // Device nodes through V4L2; an image sequence pattern (dir/%06d.png) through OpenCV's image
-  // reader, which reads each file when grabbed (a missing file: the camera stopped); anything
-  // else (a video file) through whichever backend opens it.
-  const bool node = d.path.rfind("/dev/", 0) == 0;
-  const bool sequence = d.path.find('%') != std::string::npos;
-  try {
-    d.cap.open(d.path, node ? cv::CAP_V4L2 : sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
-    if (d.cap.isOpened() && node) {
-      d.cap.set(cv::CAP_PROP_FRAME_WIDTH, cameras_[k].width);
-      d.cap.set(cv::CAP_PROP_FRAME_HEIGHT, cameras_[k].height);
-    }
-  } catch (const cv::Exception&) {
-    d.cap.release();  // unopenable now: retried later
-  }
-  d.open = d.cap.isOpened();
+  d.open = open_capture(d.cap, d.path, cameras_[k].width, cameras_[k].height);
   return d.open;
 }
 
@@ -84,8 +95,7 @@ void V4l2Source::went_dark(std::size_t k, std::int64_t now_ns) {
   Device& d = devices_[k];
   d.cap.release();
   d.open = false;
-  d.backoff_s = policy_.initial_s;
-  d.retry_at_ns = now_ns + seconds_to_ns(d.backoff_s);
+  d.retry.went_dark(policy_, now_ns);
 }
 
 bool V4l2Source::grab(Frame& frame) {
@@ -94,13 +104,12 @@ bool V4l2Source::grab(Frame& frame) {
   const std::int64_t before = crease::rt::now_ns();
   for (std::size_t k = 0; k < devices_.size(); ++k) {
     Device& d = devices_[k];
-    if (d.open || before < d.retry_at_ns) continue;
+    if (d.open || !d.retry.due(before)) continue;
     if (try_open(k)) {
       reconnects_[k].fetch_add(1, std::memory_order_acq_rel);
       total_reconnects_.fetch_add(1, std::memory_order_acq_rel);
     } else {
-      d.retry_at_ns = before + seconds_to_ns(d.backoff_s);
-      d.backoff_s = std::min(2.0 * d.backoff_s, policy_.max_s);
+      d.retry.failed_again(policy_, before);
     }
   }
   // grab() all first so the exposures are as close in time as the devices allow.

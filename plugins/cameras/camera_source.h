@@ -88,6 +88,24 @@ struct ReconnectPolicy {
   double max_s = 5.0;
 };
 
+// One live camera's retry clock under a ReconnectPolicy (the capture worker's).
+struct ReconnectClock {
+  std::int64_t retry_at_ns = 0;  // next open attempt while closed
+  double backoff_s = 0;          // wait after the next failed attempt
+  // Closed at NOW_NS: the first attempt initial_s later.
+  void went_dark(const ReconnectPolicy& p, std::int64_t now_ns) noexcept;
+  [[nodiscard]] bool due(std::int64_t now_ns) const noexcept { return now_ns >= retry_at_ns; }
+  // The attempt at NOW_NS failed: the next one the current wait later, the wait then doubled
+  // up to max_s.
+  void failed_again(const ReconnectPolicy& p, std::int64_t now_ns) noexcept;
+};
+
+// Opens PATH into CAP: /dev/... through V4L2, asking for WIDTH x HEIGHT; an image sequence
+// pattern (dir/%06d.png) through OpenCV's image reader, which reads each file when grabbed (a
+// missing file: the camera stopped); anything else (a video file) through whichever backend
+// opens it. False when it did not open (an OpenCV exception included).
+bool open_capture(cv::VideoCapture& cap, const std::string& path, int width, int height);
+
 // Live cameras through cv::VideoCapture; device k is cameras[k]. /dev/... opens with the V4L2
 // backend; an image sequence pattern (dir/%06d.png) with OpenCV's image reader (a file missing
 // when its turn comes is a camera that stopped); any other string (a video file) with whichever
@@ -124,8 +142,7 @@ class V4l2Source final : public CameraSource {
     std::string path;
     cv::VideoCapture cap;
     bool open = false;
-    std::int64_t retry_at_ns = 0;  // next open attempt while closed
-    double backoff_s = 0;          // wait after the next failed attempt
+    ReconnectClock retry;
   };
   bool try_open(std::size_t k);                   // true when it opened
   void went_dark(std::size_t k, std::int64_t now_ns);  // release, retry after initial_s

@@ -20,18 +20,11 @@ class CameraV4l2Plugin final : public CameraPlugin {
  public:
   void configure(const crease::Params& p, crease::PortBinder& ports) override {
     auto cams = load_camera_dir(p.get_path("cameras", "cameras"));
-    std::vector<std::string> devices;
-    const YAML::Node d = p.raw("devices");
-    if (!d || !d.IsSequence()) p.fail("devices", "expected a list of video devices");
-    for (const auto& n : d) devices.push_back(p.resolve_path(n.as<std::string>()));
+    const std::vector<std::string> devices = read_device_list(p, "devices");
     if (devices.size() != cams.size())
       p.fail("devices", std::to_string(devices.size()) + " devices for " +
                             std::to_string(cams.size()) + " calibrations");
-    ReconnectPolicy retry;
-    retry.initial_s = p.get_in_range<double>("reconnect_initial_s", 0.5, 0.001, 60.0);
-    retry.max_s = p.get_in_range<double>("reconnect_max_s", 5.0, 0.001, 3600.0);
-    if (retry.max_s < retry.initial_s)
-      p.fail("reconnect_max_s", "must be at least reconnect_initial_s");
+    const ReconnectPolicy retry = read_reconnect_policy(p);
     devices_ = devices;
     auto src = std::make_unique<V4l2Source>(std::move(cams), devices, retry);
     for (const std::string& dev : src->failed_devices())

@@ -1,19 +1,10 @@
 #include "plugins/cameras/v4l2_depth_source.h"
 
-#include <algorithm>
-
 #include "core/assert.h"
 #include "core/errors.h"
 #include "rt/clock.h"
 
 namespace crease::vision {
-namespace {
-
-std::int64_t seconds_to_ns(double s) {
-  return static_cast<std::int64_t>(s * 1e9);
-}
-
-}  // namespace
 
 V4l2DepthSource::V4l2DepthSource(std::vector<DepthCamera> cameras,
                                  const std::vector<std::string>& depth_devices,
@@ -68,20 +59,8 @@ std::string V4l2DepthSource::try_open(std::size_t k) {
   cfg.width = c.width;
   cfg.height = c.height;
   std::string why = d.depth->open(cfg);
-  if (why.empty()) {
-    const bool node = d.colour_path.rfind("/dev/", 0) == 0;
-    const bool sequence = d.colour_path.find('%') != std::string::npos;
-    try {
-      d.colour.open(d.colour_path, node ? cv::CAP_V4L2 : sequence ? cv::CAP_IMAGES : cv::CAP_ANY);
-      if (d.colour.isOpened() && node) {
-        d.colour.set(cv::CAP_PROP_FRAME_WIDTH, c.width);
-        d.colour.set(cv::CAP_PROP_FRAME_HEIGHT, c.height);
-      }
-    } catch (const cv::Exception&) {
-      d.colour.release();
-    }
-    if (!d.colour.isOpened()) why = d.colour_path + ": does not open";
-  }
+  if (why.empty() && !open_capture(d.colour, d.colour_path, c.width, c.height))
+    why = d.colour_path + ": does not open";
   d.open = why.empty();
   if (!d.open) {
     d.depth->close();
@@ -95,8 +74,7 @@ void V4l2DepthSource::went_dark(std::size_t k, std::int64_t now_ns) {
   d.depth->close();
   d.colour.release();
   d.open = false;
-  d.backoff_s = policy_.initial_s;
-  d.retry_at_ns = now_ns + seconds_to_ns(d.backoff_s);
+  d.retry.went_dark(policy_, now_ns);
 }
 
 bool V4l2DepthSource::grab(Frame& frame) {
@@ -107,12 +85,11 @@ bool V4l2DepthSource::grab(Frame& frame) {
   const std::int64_t before = crease::rt::now_ns();
   for (std::size_t k = 0; k < nodes_.size(); ++k) {
     Node& d = nodes_[k];
-    if (d.open || before < d.retry_at_ns) continue;
+    if (d.open || !d.retry.due(before)) continue;
     if (try_open(k).empty()) {
       reconnects_.fetch_add(1, std::memory_order_acq_rel);
     } else {
-      d.retry_at_ns = before + seconds_to_ns(d.backoff_s);
-      d.backoff_s = std::min(2.0 * d.backoff_s, policy_.max_s);
+      d.retry.failed_again(policy_, before);
     }
   }
   frame.timestamp_ns = 0;

@@ -71,8 +71,7 @@ class V4l2DepthSource final : public CameraSource {
     std::unique_ptr<V4l2Z16Device> depth;
     cv::VideoCapture colour;
     bool open = false;
-    std::int64_t retry_at_ns = 0;
-    double backoff_s = 0;
+    ReconnectClock retry;
   };
   std::string try_open(std::size_t k);  // empty when both nodes opened
   void went_dark(std::size_t k, std::int64_t now_ns);
