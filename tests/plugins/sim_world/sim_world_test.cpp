@@ -1,7 +1,8 @@
 // The world's step as a unit: one seed, one trajectory (bit for bit); bad commands clamped,
 // refused and counted; a non-finite step rolled back; the fastest motions the drives allow
 // never put a finger more than 1 mm into the sheet or the table; a step allocates nothing; the
-// sheet exported as a SheetState; how deep the kinematic arms reach under the table.
+// sheet exported as a SheetState; how deep the kinematic arms reach under the table; the sheet
+// pushed into the table's slab comes back out through its top.
 #include "plugins/sim_world/sim_world.h"
 
 #include <doctest/doctest.h>
@@ -214,4 +215,26 @@ TEST_CASE(
   CHECK(s.under_table_mm[0] > 100.0f);
   CHECK(s.under_table_mm[0] < 400.0f);
   CHECK(s.all_finite());
+}
+
+TEST_CASE(
+    "a patch of the sheet pushed into the table comes back out through its top, at any depth the "
+    "slab holds") {
+  for (const double depth : {1.0, 2.0, 3.0, 4.5, 8.0, 20.0}) {
+    CAPTURE(depth);
+    Rig rig(nominal(), "ffpad", {20, 40, 80}, palm_forward_down(robot::Side::right, deg(30)),
+            index_out());
+    auto& sheet = rig.world->sheet();
+    std::vector<Vec3> x(sheet.positions().begin(), sheet.positions().end());
+    const auto& g = sheet.grid();
+    // A 5 x 5 patch in the middle of the sheet, DEPTH under the top (its edges slope down to it).
+    for (int j = 18; j < 23; ++j)
+      for (int i = 12; i < 17; ++i) x[g.index(i, j)].z = -depth;
+    sheet.set_positions(x);
+    rig.hold(0.3);
+    double lowest = 1e9;
+    for (const Vec3& p : rig.world->sheet().positions()) lowest = std::min(lowest, p.z);
+    CHECK(lowest > -0.1);
+    CHECK(lowest < 1.0);
+  }
 }
