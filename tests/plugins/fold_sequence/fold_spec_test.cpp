@@ -74,8 +74,8 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.lay_mm[2] == -22.0);
   CHECK(h.refixate_out_mm[0] == 255.0);
   CHECK(h.refixate_out_force_n == 0.5);
-  CHECK(h.swipe_withdraw_mm[1] == 44.5);
-  CHECK(h.swipe_withdraw_mm[2] == -24.0);
+  CHECK(h.swipe_withdraw_mm[1] == -25.0);
+  CHECK(h.swipe_withdraw_mm[2] == -26.0);
   CHECK(h.pinch_fingers == 0x11);
   CHECK(h.pinching_side == 0);      // the right hand pinches
   CHECK(h.pinch_force_n == 0.2);
