@@ -12,6 +12,10 @@
 namespace crease::fold {
 namespace {
 
+// How far (x, y, mm) the laid layer's nearest node of the tracked sheet may lie from the fixing
+// tool for its press to hold it: a cell and a half of the tracking model's 15 mm grid.
+constexpr double kPressReachMm = 22.5;
+
 void set_limits(ArmGoal& g, const MotionLimits& l) noexcept {
   g.speed_mm_s = l.speed_mm_s;
   g.accel_mm_s2 = l.accel_mm_s2;
@@ -479,7 +483,21 @@ void Machine::enter(S s, const Sensing& in, Outbox& out) noexcept {
     case S::refix_lift: arm_lift(kFixing, f.release_lift_mm, out); break;
     case S::refix_approach: approach(kFixing, f.refixate, out); break;
     case S::refix_contact: descend(kFixing, f.refixate, out); break;
-    case S::refix_press: hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out); break;
+    case S::refix_press: {
+      hand_force(kFixing, f.refixate.fingers, f.refixate.force_n, in, out);
+      // The laid layer's point under the fixing tool, as the model has it now (the pinch still
+      // holds the layer): what this press holds from now on (press_target).
+      const ArmMotionStatus* a = in.arm[kFixing];
+      m_.press_held = 0;
+      if (in.sheet != nullptr && a != nullptr && a->tool_measured != 0 && a->all_finite()) {
+        const double p[3] = {a->tool_mm[0], a->tool_mm[1], a->tool_mm[2]};
+        m_.press_held = part_point_under(*in.sheet, f.fold_line_mm[0], f.fold_line_mm[1],
+                                         f.grasp_at_mm, p, kPressReachMm, m_.press_uv)
+                            ? 1
+                            : 0;
+      }
+      break;
+    }
     case S::swipe_release:
       hand_posture(kPinching, f.prepinch_rad, in, out,
                    f.has_release_stiffness ? f.release_stiffness : nullptr, f.release_ramp_s);

@@ -405,4 +405,19 @@ bool Machine::grasp_target(const Sensing& in, double world_mm[3],
   return true;
 }
 
+bool Machine::press_target(const Sensing& in, double world_mm[3],
+                           double sheet_mm[2]) const noexcept {
+  const S leaf = m_.leaf;
+  const bool pressing = leaf == S::refix_press || is_within(leaf, S::swipe) ||
+                        is_within(leaf, S::harden) || leaf == S::finish_memorize;
+  const ArmMotionStatus* a = in.arm[kFixing];
+  if (!pressing || m_.press_held == 0 || a == nullptr || a->tool_measured == 0 ||
+      a->tool != spec_.refixate.tool || !a->all_finite())
+    return false;
+  for (int c = 0; c < 3; ++c) world_mm[c] = a->tool_mm[c];
+  sheet_mm[0] = m_.press_uv[0];
+  sheet_mm[1] = m_.press_uv[1];
+  return true;
+}
+
 }  // namespace crease::fold

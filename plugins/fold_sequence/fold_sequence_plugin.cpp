@@ -33,7 +33,7 @@ void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
   target_value_ = std::make_unique<TargetPoints>();
   target_ = ports.latest_output<TargetPoints>("target_points", *target_value_);
   target_written_ns_ = 0;
-  target_on_ = false;
+  targets_on_ = 0;
 }
 
 void FoldSequencePlugin::activate() { started_ = false; }
@@ -82,7 +82,7 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   if (lost) machine_->fail(Reason::command_lost);
   log_retreat(out);
 
-  write_grasp_target(in, c.time_ns);
+  write_targets(in, c.time_ns);
   machine_->fill_status(status_value_, c.time_ns);
   status_.write(status_value_, c.time_ns);
   if (status_value_.transitions != logged_transitions_) {
@@ -103,21 +103,23 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   return status_value_.phase == SequenceStatus::aborted ? Status::degraded : Status::ok;
 }
 
-void FoldSequencePlugin::write_grasp_target(const Sensing& in, std::int64_t now_ns) noexcept {
-  double world[3], sheet[2];
-  const bool on = machine_->grasp_target(in, world, sheet);
-  if (!on && !target_on_) return;
-  if (on && target_on_ && now_ns - target_written_ns_ < kTargetPeriodNs) return;
+void FoldSequencePlugin::write_targets(const Sensing& in, std::int64_t now_ns) noexcept {
+  double world[2][3], sheet[2][2];
+  std::uint32_t n = 0;
+  if (machine_->grasp_target(in, world[n], sheet[n])) ++n;
+  if (machine_->press_target(in, world[n], sheet[n])) ++n;
+  if (n == 0 && targets_on_ == 0) return;
+  if (n == targets_on_ && now_ns - target_written_ns_ < kTargetPeriodNs) return;
   TargetPoints& t = *target_value_;
   t.timestamp_ns = now_ns;
-  t.count = on ? 1 : 0;
-  if (on) {
-    for (int c = 0; c < 3; ++c) t.points[0].world_mm[c] = static_cast<float>(world[c]);
-    for (int c = 0; c < 2; ++c) t.points[0].sheet_mm[c] = static_cast<float>(sheet[c]);
+  t.count = n;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    for (int c = 0; c < 3; ++c) t.points[k].world_mm[c] = static_cast<float>(world[k][c]);
+    for (int c = 0; c < 2; ++c) t.points[k].sheet_mm[c] = static_cast<float>(sheet[k][c]);
   }
   target_.write(t, now_ns);
   target_written_ns_ = now_ns;
-  target_on_ = on;
+  targets_on_ = n;
 }
 
 void FoldSequencePlugin::log_retreat(const Outbox& out) const noexcept {

@@ -15,11 +15,14 @@
 //   sheet_crease                  queue out   crease::SheetCreaseEvent
 //   sheet_memorize                queue out   crease::SheetMemorizeEvent
 //   sequence_status               latest out  crease::SequenceStatus (creasectl status shows it)
-//   target_points                 latest out  crease::TargetPoints: while the pinch holds
-//                                             the sheet, one target, the grasp point where the
-//                                             pinching arm's readings put the tool
-//                                             (Machine::grasp_target), every kTargetPeriodNs;
-//                                             none (count 0) once it lets go
+//   target_points                 latest out  crease::TargetPoints, every kTargetPeriodNs
+//                                             while any holds: the grasp point where the
+//                                             pinching arm's readings put the tool while the
+//                                             pinch holds the sheet (Machine::grasp_target),
+//                                             the laid layer's point the fixing hand presses
+//                                             where its arm's readings put that tool
+//                                             (Machine::press_target); count 0 when
+//                                             neither holds
 // Parameters: fold (path of a sequence file, required), auto_start (false), sheet_poll_ms (200;
 // must stay below the file's sheet_max_age_s less the model's period). Tunable `command`
 // (0..5, integers): 1 start, 2 pause, 3 resume, 4 abort, 5 step; read once and reset to 0 by
@@ -58,7 +61,8 @@ class FoldSequencePlugin final : public Plugin {
  private:
   // RT. Logs what the abort's retreat did this cycle (Outbox's retried, joints_park, gave_up).
   void log_retreat(const Outbox& out) const noexcept;
-  void write_grasp_target(const Sensing& in, std::int64_t now_ns) noexcept;
+  // RT. The machine's targets (grasp, press) onto target_points.
+  void write_targets(const Sensing& in, std::int64_t now_ns) noexcept;
   FoldSpec spec_;
   std::unique_ptr<Machine> machine_;
   std::unique_ptr<Outbox> outbox_;
@@ -80,7 +84,7 @@ class FoldSequencePlugin final : public Plugin {
   LatestOutput<TargetPoints> target_;
   std::unique_ptr<TargetPoints> target_value_;  // 20 kB: not on the stack
   std::int64_t target_written_ns_ = 0;
-  bool target_on_ = false;
+  std::uint32_t targets_on_ = 0;                               // how many the last write carried
   static constexpr std::int64_t kTargetPeriodNs = 10'000'000;  // 100 Hz: the model runs at 60
   SequenceStatus status_value_{};
 };

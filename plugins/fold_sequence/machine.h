@@ -97,8 +97,8 @@ struct Memory {
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
   // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
   // park in joint space, halved while out of reach); 6: aborted_from; 7: pinch_off_since_ns;
-  // 8: held_frame; 9: shift/check, slides
-  static constexpr std::uint32_t kVersion = 9;
+  // 8: held_frame; 9: shift/check, slides; 10: press_held, press_uv
+  static constexpr std::uint32_t kVersion = 10;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -159,6 +159,10 @@ struct Memory {
   // the world by this frame (uses_held_frame).
   std::uint8_t frame_held = 0;
   SheetFrame held_frame{};
+  // The laid layer's point (u, v) under the fixing tool as the refixation's press began, in the
+  // tracked sheet (press_held 0: the model had none of the layer there): what that press holds.
+  std::uint8_t press_held = 0;
+  double press_uv[2] = {0, 0};
 };
 
 class Machine {
@@ -184,6 +188,13 @@ class Machine {
   // (`target_points`): the robot knows where its fingers hold the sheet when the hand hides the
   // flap's markers from the cameras, or the fold turns them away. False otherwise.
   [[nodiscard]] bool grasp_target(const Sensing& in, double world_mm[3],
+                                  double sheet_mm[2]) const noexcept;
+  // RT. While the fixing hand presses both layers (refixate/press, the swipe, the hardening,
+  // the memorize): the laid layer's point it holds (sheet mm, Memory::press_uv) and where the
+  // fixing arm's readings put the fixing tool (world mm). The laid layer shows the cameras its
+  // unprinted back, and once the pinch lets go nothing else tells the model where it lies.
+  // False otherwise.
+  [[nodiscard]] bool press_target(const Sensing& in, double world_mm[3],
                                   double sheet_mm[2]) const noexcept;
 
  private:

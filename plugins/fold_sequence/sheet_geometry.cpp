@@ -104,6 +104,58 @@ bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept {
   return node(s, i, j, out);
 }
 
+bool part_point_under(const SheetState& s, const double a[2], const double b[2],
+                      const double side[2], const double p[3], double max_mm,
+                      double uv[2]) noexcept {
+  if (!usable(s)) return false;
+  const double lx = b[0] - a[0], ly = b[1] - a[1], len = std::hypot(lx, ly);
+  if (!(len > 0)) return false;
+  // Signed distance from the line (mm), positive on SIDE's side.
+  const double sign = (lx * (side[1] - a[1]) - ly * (side[0] - a[0])) >= 0 ? 1.0 : -1.0;
+  const auto beyond = [&](double u, double v) {
+    return sign * (lx * (v - a[1]) - ly * (u - a[0])) / len;
+  };
+  const double du = s.width_mm / (s.nodes_u - 1), dv = s.height_mm / (s.nodes_v - 1);
+  int bi = -1, bj = -1;
+  double best = max_mm * max_mm;
+  for (int j = 0; j < s.nodes_v; ++j)
+    for (int i = 0; i < s.nodes_u; ++i) {
+      if (beyond(i * du, j * dv) < 1.0) continue;
+      double q[3];
+      if (!node(s, i, j, q)) continue;
+      const double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]);
+      if (d2 <= best) {
+        best = d2;
+        bi = i, bj = j;
+      }
+    }
+  if (bi < 0) return false;
+  uv[0] = bi * du;
+  uv[1] = bj * dv;
+  // One linear step: the grid's world x, y per mm of u and of v at the node (central
+  // differences, one-sided at the border), solved for the offset to P, at most one cell.
+  double q[3], e[2][2];
+  if (!node(s, bi, bj, q)) return false;
+  for (int k = 0; k < 2; ++k) {
+    const int n = k == 0 ? s.nodes_u : s.nodes_v, at = k == 0 ? bi : bj;
+    const int lo = std::max(at - 1, 0), hi = std::min(at + 1, n - 1);
+    double ql[3], qh[3];
+    if (!node(s, k == 0 ? lo : bi, k == 0 ? bj : lo, ql) ||
+        !node(s, k == 0 ? hi : bi, k == 0 ? bj : hi, qh))
+      return true;
+    const double span = (hi - lo) * (k == 0 ? du : dv);
+    e[k][0] = (qh[0] - ql[0]) / span;
+    e[k][1] = (qh[1] - ql[1]) / span;
+  }
+  const double det = e[0][0] * e[1][1] - e[1][0] * e[0][1];
+  if (!(std::fabs(det) > 0.25)) return true;  // the part stands steep here: the node as it is
+  const double rx = p[0] - q[0], ry = p[1] - q[1];
+  const double su = (rx * e[1][1] - ry * e[1][0]) / det, sv = (e[0][0] * ry - e[0][1] * rx) / det;
+  uv[0] = std::clamp(uv[0] + std::clamp(su, -du, du), 0.0, static_cast<double>(s.width_mm));
+  uv[1] = std::clamp(uv[1] + std::clamp(sv, -dv, dv), 0.0, static_cast<double>(s.height_mm));
+  return true;
+}
+
 bool nearest_crease(const SheetState& s, double a[2], double b[2]) noexcept {
   const std::uint32_t n = std::min(s.crease_count, SheetState::kMaxCreases);
   double best = 1e300;

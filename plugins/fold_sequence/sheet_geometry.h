@@ -34,6 +34,13 @@ void turn_about_vertical(const SheetFrame& f, double alpha_rad, const double q[4
                          double q_out[4]) noexcept;
 // The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
 [[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
+// The sheet point (u, v) mm of the tracked sheet's part beyond the line A-B (sheet mm; the side
+// SIDE lies on) that lies under world point P: the node of that part nearest to P in x, y (nodes
+// within 1 mm of the line left out), within MAX_MM, refined by one linear step of its grid
+// neighbours (at most one cell). What a finger pressing a laid flap holds. False when none.
+[[nodiscard]] bool part_point_under(const SheetState& s, const double a[2], const double b[2],
+                                    const double side[2], const double p[3], double max_mm,
+                                    double uv[2]) noexcept;
 // The crease of s nearest to the segment a-b (sheet mm, by the sum of its end points'
 // distances, either direction), into a, b (oriented like the given one). False when s has none.
 [[nodiscard]] bool nearest_crease(const SheetState& s, double a[2], double b[2]) noexcept;

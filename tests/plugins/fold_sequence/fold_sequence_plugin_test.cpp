@@ -594,6 +594,66 @@ TEST_CASE(
   CHECK(read().count == 0);
 }
 
+TEST_CASE(
+    "while the fixing hand presses both layers the model gets the laid layer's point under it, "
+    "taken from the tracked sheet as the press began, where the fixing arm's readings put the "
+    "tool") {
+  Rig r;
+  auto targets = r.ports().latest_input<TargetPoints>("target_points");
+  const auto read = [&] {
+    (void)targets.poll();
+    return targets.has_value() ? targets.value() : TargetPoints{};
+  };
+  const auto at = [&](int i, int j) {
+    const float* p = r.sheet().position_mm[j * 3 + i];
+    return std::array<double, 3>{p[0], p[1], p[2]};
+  };
+  start_and_run_to(r, "fold/refixate/slide_out");  // the model polled again before the press
+  SUBCASE("the layer laid: its row v 297 over the near edge's, 1 mm up") {
+    for (int i = 0; i < 3; ++i) {
+      const auto near = at(i, 0);
+      r.set_node(i, 2, near[0], near[1], near[2] + 1.0);
+    }
+    // The fixing tool 14.85 mm from node (105, 297) towards the crease (a tenth of v's cell).
+    const auto n = at(1, 2), crease = at(1, 1);
+    for (int c = 0; c < 3; ++c) r.tool_at[kFix][c] = n[c] + 0.1 * (crease[c] - n[c]);
+    REQUIRE(r.run_to("fold/refixate/press"));
+    r.run(12);
+    REQUIRE(std::string(r.status().path) == "fold/refixate/press");
+    TargetPoints t = read();
+    REQUIRE(t.count == 2);  // the pinch still holds the layer: its grasp point, then the press
+    CHECK(t.points[1].world_mm[0] == static_cast<float>(r.tool_at[kFix][0]));
+    CHECK(t.points[1].sheet_mm[0] == doctest::Approx(105.0).epsilon(1e-4));
+    CHECK(t.points[1].sheet_mm[1] == doctest::Approx(297.0 - 14.85).epsilon(1e-4));
+    // The pinch lets go: the press alone, following the fixing arm's readings.
+    REQUIRE(r.run_to("fold/swipe/withdraw"));
+    r.tool_at[kFix][2] = 3.5;
+    r.run(15);
+    t = read();
+    REQUIRE(t.count == 1);
+    CHECK(t.points[0].world_mm[2] == 3.5f);
+    CHECK(t.points[0].sheet_mm[1] == doctest::Approx(297.0 - 14.85).epsilon(1e-4));
+    REQUIRE(r.run_to("fold/harden/approach"));
+    r.run(15);
+    CHECK(read().count == 1);
+    r.command(Command::abort);
+    r.run(50);
+    CHECK(read().count == 0);
+  }
+  SUBCASE(
+      "the tracked sheet has no layer over the fixing tool (failing variant): no press target") {
+    // Over corner (0, 0): the model's flap lies unfolded but for its grasp point, laid 105 mm off.
+    const auto n = at(0, 0);
+    for (int c = 0; c < 3; ++c) r.tool_at[kFix][c] = n[c];
+    REQUIRE(r.run_to("fold/refixate/press"));
+    r.run(12);
+    CHECK(read().count == 1);  // the grasp point alone
+    REQUIRE(r.run_to("fold/swipe/withdraw"));
+    r.run(15);
+    CHECK(read().count == 0);
+  }
+}
+
 TEST_CASE("faults abort with their reason; the retreat leaves both hands open") {
   using crease::fold::Reason;
   SUBCASE("device fault: the arm's drive faults during a motion") {

@@ -162,6 +162,13 @@ class Rig {
         for (int c = 0; c < 3; ++c) flat_[j * 3 + i][c] = p[c];
       }
   }
+  // Node (i, j) of the tracked sheet to world (x, y, z) mm (a shape the model took).
+  void set_node(int i, int j, double x, double y, double z) {
+    float* p = sheet_->position_mm[j * sheet_->nodes_u + i];
+    p[0] = static_cast<float>(x);
+    p[1] = static_cast<float>(y);
+    p[2] = static_cast<float>(z);
+  }
   // The laid layer springs back: the node the pinch carried returns to where it lay flat (the
   // tracked sheet unfolded).
   void spring_back() {

@@ -187,3 +187,38 @@ TEST_CASE(
   turn_about_vertical(f, 0.0, q, same);
   for (int c = 0; c < 4; ++c) CHECK(same[c] == doctest::Approx(q[c]).epsilon(1e-9));
 }
+
+TEST_CASE(
+    "the point of a folded part under a world point: the part's nearest node, refined within its "
+    "cell") {
+  // 15 x 21 nodes (15 x 14.85 mm cells), flat, u along +x, v along -y; then the far half
+  // (v > 148.5) folded flat over the near half, 1 mm up: node (i, j) over node (i, 20 - j).
+  auto s = sheet(15, 21, 0, 0, 0.0);
+  for (int j = 11; j < 21; ++j)
+    for (int i = 0; i < 15; ++i)
+      for (int c = 0; c < 3; ++c)
+        s->position_mm[j * 15 + i][c] =
+            s->position_mm[(20 - j) * 15 + i][c] + (c == 2 ? 1.0f : 0.0f);
+  const double a[2] = {0, 148.5}, b[2] = {210, 148.5}, far_side[2] = {105, 282.5};
+  double uv[2];
+  // Over sheet point (100, 40) of the near half, i.e. (100, 257) of the folded one.
+  const double p[3] = {100, -40, 5};
+  REQUIRE(part_point_under(*s, a, b, far_side, p, 22.5, uv));
+  CHECK(uv[0] == doctest::Approx(100.0));
+  CHECK(uv[1] == doctest::Approx(257.0));
+  // The near part asked for: the near half's own point.
+  const double near_side[2] = {105, 10};
+  REQUIRE(part_point_under(*s, a, b, near_side, p, 22.5, uv));
+  CHECK(uv[1] == doctest::Approx(40.0));
+  // Unfolded, the far half lies beyond y = -148.5: nothing of it within reach of p.
+  const auto flat = sheet(15, 21, 0, 0, 0.0);
+  CHECK_FALSE(part_point_under(*flat, a, b, far_side, p, 22.5, uv));
+  // Over the line: the part's nearest node is the next row (the line's own nodes belong to
+  // neither part), and its cell's step reaches the line.
+  const double on_line[3] = {105, -148.5, 0};
+  REQUIRE(part_point_under(*flat, a, b, far_side, on_line, 22.5, uv));
+  CHECK(uv[0] == doctest::Approx(105.0));
+  CHECK(uv[1] == doctest::Approx(148.5));
+  const double degenerate[2] = {0, 148.5};
+  CHECK_FALSE(part_point_under(*s, a, degenerate, far_side, p, 22.5, uv));
+}
