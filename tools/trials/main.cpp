@@ -13,6 +13,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <spdlog/spdlog.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -26,8 +27,7 @@
 #include <string>
 #include <vector>
 
-#include <spdlog/spdlog.h>
-
+#include "tools/trials/trial_json.h"
 #include "tools/trials/trial_report.h"
 #include "tools/trials/trial_run.h"
 #include "tools/trials/trial_table.h"

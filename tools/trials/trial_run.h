@@ -14,8 +14,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/config/daemon_config.h"
 #include "tools/trials/trial_score.h"
 
@@ -86,6 +84,13 @@ struct SeriesSample {
   int palm_contact[2] = {-1, -1};
   double wrist_deflection_deg[2] = {std::numeric_limits<double>::quiet_NaN(),
                                     std::numeric_limits<double>::quiet_NaN()};
+  // How far the tracked sheet puts the grasp point (above) from where the world's is (x, y, z),
+  // mm: the tracker's error at the flap, which fold_lost and pinch_lost judge by; NaN without
+  // both.
+  double grasp_off_mm = std::numeric_limits<double>::quiet_NaN();
+  // The tracked sheet's observations (sheet_state: the markers' key-points its last update took,
+  // the targets not counted); -1 without a state.
+  long observations = -1;
 };
 inline constexpr double kSeriesS = 0.02;
 
@@ -127,8 +132,5 @@ struct TrialResult {
 // Whether the trial succeeded, and why not: the sequence done, the sheet's shape within the
 // bounds, not torn, on the table, the hands clear.
 void judge(TrialResult& r);
-
-[[nodiscard]] nlohmann::json to_json(const TrialResult& r);
-[[nodiscard]] TrialResult from_json(const nlohmann::json& j);
 
 }  // namespace crease::trials

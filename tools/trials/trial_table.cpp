@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "tools/trials/trial_json.h"
+
 namespace crease::trials {
 namespace {
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 
+#include "tools/trials/trial_json.h"
 #include "tools/trials/trial_run.h"
 #include "tools/trials/trial_table.h"
 
@@ -330,4 +331,14 @@ TEST_CASE("the summary: p95 and the minimum count a trial without a figure as th
   CHECK(back.series[0].palm_contact[1] == -1);
   CHECK(back.series[0].wrist_deflection_deg[0] == 12.25);
   CHECK(std::isnan(back.series[0].wrist_deflection_deg[1]));
+  // ... and the tracker's error at the grasp point and the model's observations (unset: -1 and
+  // null).
+  CHECK(std::isnan(back.series[0].grasp_off_mm));
+  CHECK(back.series[0].observations == -1);
+  TrialResult d = b;
+  d.series[0].grasp_off_mm = 104.5;
+  d.series[0].observations = 37;
+  const TrialResult d_back = from_json(to_json(d));
+  CHECK(d_back.series[0].grasp_off_mm == 104.5);
+  CHECK(d_back.series[0].observations == 37);
 }
