@@ -321,6 +321,7 @@ Reason Machine::fault(const Sensing& in) noexcept {
       return found(n.arm_aborted, Reason::motion_aborted);
     }
   }
+  if (flap_open(in)) return found("the laid layer's printed face seen", Reason::fold_lost);
   // Off the way on every model state for pinch_lost_s: the tracker alone can put it there for a
   // moment (its error over a trial's frames reaches 30-60 mm at its worst).
   if (!seen) return Reason::none;  // a state without observations tells nothing either way
@@ -418,6 +419,37 @@ bool Machine::press_target(const Sensing& in, double world_mm[3],
   sheet_mm[0] = m_.press_uv[0];
   sheet_mm[1] = m_.press_uv[1];
   return true;
+}
+
+bool Machine::flap_open(const Sensing& in) noexcept {
+  // Laid, the layer shows the cameras its unprinted back (a sprung-open layer showed 112-170
+  // key-points where the laid one left 5-20 in a trial, seed 23); the markers' key-points say so
+  // within a frame or two, where the model, held by the grasp and press targets, may keep the
+  // layer laid for seconds.
+  constexpr double kBeyondMm = 15.0;  // a model cell past the line: not the crease's own row
+  const S leaf = m_.leaf;
+  const bool laid = is_within(leaf, S::fixate_layer) || is_within(leaf, S::refixate) ||
+                    is_within(leaf, S::swipe) || is_within(leaf, S::harden);
+  const Keypoints* k = in.keypoints;
+  if (spec_.flap_seen_points == 0 || !laid || k == nullptr ||
+      !fresh(k->timestamp_ns, in.now_ns, spec_.sheet_max_age_s)) {
+    m_.flap_seen_since_ns = 0;
+    return false;
+  }
+  std::uint32_t n = 0;
+  const std::uint32_t count = std::min(k->count, Keypoints::kCapacity);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Keypoint& p = k->points[i];
+    if (p.face == 0 && beyond_line(spec_.fold_line_mm[0], spec_.fold_line_mm[1], spec_.grasp_at_mm,
+                                   p.sheet_mm[0], p.sheet_mm[1]) > kBeyondMm)
+      ++n;
+  }
+  if (n < spec_.flap_seen_points) {
+    m_.flap_seen_since_ns = 0;
+    return false;
+  }
+  if (m_.flap_seen_since_ns == 0) m_.flap_seen_since_ns = in.now_ns;
+  return static_cast<double>(in.now_ns - m_.flap_seen_since_ns) * 1e-9 >= spec_.flap_seen_s;
 }
 
 }  // namespace crease::fold

@@ -27,6 +27,7 @@ void FoldSequencePlugin::configure(const Params& p, PortBinder& ports) {
     hand_goal_[s] = ports.queue_output<HandGoal>("hand_" + x + "_goal", kHandGoalQueue);
   }
   sheet_ = ports.latest_input<SheetState>("sheet_state");
+  keypoints_ = ports.latest_input<Keypoints>("keypoints");
   crease_ = ports.queue_output<SheetCreaseEvent>("sheet_crease");
   memorize_ = ports.queue_output<SheetMemorizeEvent>("sheet_memorize");
   status_ = ports.latest_output<SequenceStatus>("sequence_status", SequenceStatus{});
@@ -69,6 +70,12 @@ Status FoldSequencePlugin::update(const Cycle& c) {
     sheet_polled_ns_ = c.time_ns;
   }
   if (sheet_.has_value()) in.sheet = &sheet_.value();
+  // The markers' key-points (16 kB) from the lay on, while the laid layer is judged by them.
+  const S leaf = machine_->memory().leaf;
+  if (is_within(leaf, S::fixate_layer) || is_within(leaf, S::refixate) ||
+      is_within(leaf, S::swipe) || is_within(leaf, S::harden))
+    (void)keypoints_.poll();
+  if (keypoints_.has_value()) in.keypoints = &keypoints_.value();
 
   Outbox& out = *outbox_;
   machine_->step(in, out);

@@ -10,6 +10,8 @@
 //   sheet_state                   latest in   crease::SheetState (the model's: 164 kB, copied
 //                                             at most every sheet_poll_ms, and only while
 //                                             folding)
+//   keypoints                     latest in   crease::Keypoints (vision's: polled from the lay
+//                                             on, for the fold file's flap_seen_points)
 //   arm_r_goal, arm_l_goal        queue out   crease::ArmGoal
 //   hand_r_goal, hand_l_goal      queue out   crease::HandGoal
 //   sheet_crease                  queue out   crease::SheetCreaseEvent
@@ -76,6 +78,8 @@ class FoldSequencePlugin final : public Plugin {
   LatestInput<HandControlStatus> hand_status_[2];
   LatestInput<ContactState> contact_[2];
   LatestInput<SheetState> sheet_;
+  LatestInput<Keypoints>
+      keypoints_;  // optional: unbound, the laid layer is judged by the model alone
   QueueOutput<ArmGoal> arm_goal_[2];
   QueueOutput<HandGoal> hand_goal_[2];
   QueueOutput<SheetCreaseEvent> crease_;

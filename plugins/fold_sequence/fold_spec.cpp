@@ -11,6 +11,7 @@
 
 #include "core/errors.h"
 #include "core/params.h"
+#include "core/port_types/keypoints.h"
 #include "plugins/fold_sequence/states.h"
 
 namespace crease::fold {
@@ -184,6 +185,9 @@ void read(const Params& p, FoldSpec& f) {
   f.pinch_lost_mm = sn.get_in_range<double>("pinch_lost_mm", 0.0, 0.0, 1000.0);
   f.pinch_lost_s = sn.get_in_range<double>("pinch_lost_s", 0.0, 0.0, 60.0);
   f.fold_lost_mm = sn.get_in_range<double>("fold_lost_mm", 0.0, 0.0, 1000.0);
+  f.flap_seen_points =
+      sn.get_in_range<std::uint32_t>("flap_seen_points", 0u, 0u, Keypoints::kCapacity);
+  f.flap_seen_s = sn.get_in_range<double>("flap_seen_s", 0.3, 0.0, 60.0);
   f.min_observations = sn.get_in_range<std::uint32_t>("min_observations", 1u, 0u, 100000u);
   f.sheet_max_age_s = sn.get_in_range<double>("sheet_max_age_s", 0.2, 0.001, 10.0);
   f.status_max_age_s = sn.get_in_range<double>("status_max_age_s", 0.05, 0.001, 10.0);

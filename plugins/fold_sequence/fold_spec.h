@@ -57,6 +57,12 @@ struct FoldSpec {
   // The laid layer lost (swipe, harden: the pinch let go): the grasp point further than this (mm)
   // from where the layer was laid, for pinch_lost_s. 0: not checked.
   double fold_lost_mm = 0;
+  // The laid layer sprung open, seen (fixate_layer, refixate, swipe, harden): laid, the layer
+  // shows the cameras its unprinted back; at least this many marker key-points of its printed
+  // face (keypoints: face 0, (u, v) beyond the fold line by more than 15 mm) in every frame for
+  // flap_seen_s: it lies open. 0: not checked.
+  std::uint32_t flap_seen_points = 0;
+  double flap_seen_s = 0.3;
   double vision_lost_max_s = 0.5;   // sheet_state stale, or fewer than min_observations, this long: abort
   std::uint32_t min_observations = 1;
   double sheet_max_age_s = 0.2;     // a sheet_state older than this is not the current sheet

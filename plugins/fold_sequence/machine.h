@@ -24,6 +24,7 @@
 #include "core/port_types/contact.h"
 #include "core/port_types/hand_control.h"
 #include "core/port_types/hand_goal.h"
+#include "core/port_types/keypoints.h"
 #include "core/port_types/sequence_status.h"
 #include "core/port_types/sheet_state.h"
 #include "plugins/fold_sequence/fold_spec.h"
@@ -61,6 +62,7 @@ struct Sensing {
   const HandControlStatus* hand[2] = {nullptr, nullptr};
   const ContactState* contact[2] = {nullptr, nullptr};
   const SheetState* sheet = nullptr;
+  const Keypoints* keypoints = nullptr;  // the markers' key-points of the last vision frame
 };
 
 // What one cycle sends, in order per port (the plugin pushes them onto its queues).
@@ -97,8 +99,8 @@ struct Memory {
   // 2: grasp/shape; 3: fixate_layer/lay, refixate/slide_out, swipe/release, withdraw; 4: the
   // retreat's retries (arm_sent_ns, gave_up_id, park_joints); 5: park_lift_mm (the lift before a
   // park in joint space, halved while out of reach); 6: aborted_from; 7: pinch_off_since_ns;
-  // 8: held_frame; 9: shift/check, slides; 10: press_held, press_uv
-  static constexpr std::uint32_t kVersion = 10;
+  // 8: held_frame; 9: shift/check, slides; 10: press_held, press_uv; 11: flap_seen_since_ns
+  static constexpr std::uint32_t kVersion = 11;
   std::uint32_t tag = kTag;
   std::uint32_t version = kVersion;
   std::uint64_t spec_hash = 0;      // the fold this memory belongs to (name and via points)
@@ -125,6 +127,7 @@ struct Memory {
   std::int64_t elapsed_ns[kStateCount] = {};  // time in each active state, pauses not counted
   std::int64_t vision_bad_since_ns = 0;       // 0: the sheet is seen
   std::int64_t pinch_off_since_ns = 0;        // 0: the tracked grasp point is on the pinch's way
+  std::int64_t flap_seen_since_ns = 0;        // 0: the laid layer's printed face not seen
   std::uint32_t next_id = 1;
   std::uint32_t arm_id[2] = {0, 0};   // this state's arm goals (0: none)
   std::uint32_t hand_id[2] = {0, 0};  // this state's hand goals
@@ -213,6 +216,9 @@ class Machine {
   // states, or not judged (JUDGED false: a model state from within the state's first 150 ms,
   // which may lag the state's motion; the time off the way runs on through it).
   [[nodiscard]] Reason grasp_off(const SheetState& sh, bool& judged) const noexcept;
+  // spec_.flap_seen_points's check (conditions.cpp): from the lay on, the laid layer's printed
+  // face in view, in every key-point frame for flap_seen_s (Memory::flap_seen_since_ns).
+  [[nodiscard]] bool flap_open(const Sensing& in) noexcept;
   [[nodiscard]] double slide_length(const Sensing& in, double d_sheet[2],
                                     double d_world[2] = nullptr) const noexcept;
   // actions.cpp: entry and exit actions, the goals.

@@ -104,17 +104,19 @@ bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept {
   return node(s, i, j, out);
 }
 
+double beyond_line(const double a[2], const double b[2], const double side[2], double u,
+                   double v) noexcept {
+  const double lx = b[0] - a[0], ly = b[1] - a[1], len = std::hypot(lx, ly);
+  if (!(len > 0)) return std::nan("");
+  const double sign = (lx * (side[1] - a[1]) - ly * (side[0] - a[0])) >= 0 ? 1.0 : -1.0;
+  return sign * (lx * (v - a[1]) - ly * (u - a[0])) / len;
+}
+
 bool part_point_under(const SheetState& s, const double a[2], const double b[2],
                       const double side[2], const double p[3], double max_mm,
                       double uv[2]) noexcept {
-  if (!usable(s)) return false;
-  const double lx = b[0] - a[0], ly = b[1] - a[1], len = std::hypot(lx, ly);
-  if (!(len > 0)) return false;
-  // Signed distance from the line (mm), positive on SIDE's side.
-  const double sign = (lx * (side[1] - a[1]) - ly * (side[0] - a[0])) >= 0 ? 1.0 : -1.0;
-  const auto beyond = [&](double u, double v) {
-    return sign * (lx * (v - a[1]) - ly * (u - a[0])) / len;
-  };
+  if (!usable(s) || !std::isfinite(beyond_line(a, b, side, 0, 0))) return false;
+  const auto beyond = [&](double u, double v) { return beyond_line(a, b, side, u, v); };
   const double du = s.width_mm / (s.nodes_u - 1), dv = s.height_mm / (s.nodes_v - 1);
   int bi = -1, bj = -1;
   double best = max_mm * max_mm;

@@ -34,6 +34,10 @@ void turn_about_vertical(const SheetFrame& f, double alpha_rad, const double q[4
                          double q_out[4]) noexcept;
 // The world position of the node nearest to sheet coordinates (u, v) mm. False as above.
 [[nodiscard]] bool node_at(const SheetState& s, double u, double v, double out[3]) noexcept;
+// How far sheet point (U, V) lies beyond the line A-B (sheet mm), positive on the side SIDE lies
+// on, mm. NaN for a degenerate line.
+[[nodiscard]] double beyond_line(const double a[2], const double b[2], const double side[2],
+                                 double u, double v) noexcept;
 // The sheet point (u, v) mm of the tracked sheet's part beyond the line A-B (sheet mm; the side
 // SIDE lies on) that lies under world point P: the node of that part nearest to P in x, y (nodes
 // within 1 mm of the line left out), within MAX_MM, refined by one linear step of its grid

@@ -474,6 +474,56 @@ TEST_CASE("a laid layer that springs back once the pinch let go aborts the swipe
   CHECK(r.status().abort_reason == static_cast<std::uint8_t>(crease::fold::Reason::fold_lost));
 }
 
+TEST_CASE(
+    "from the lay on, the laid layer's printed face in view aborts as fold_lost within "
+    "flap_seen_s, though the model keeps the layer laid") {
+  using crease::fold::Reason;
+  // Motions of 0.6 s: the rest of the fold outlasts flap_seen_s (0.3 s).
+  SUBCASE("12 key-points beyond the fold line in the refixation: the layer lies open") {
+    Rig r;
+    r.move_cycles = 600;
+    start_and_run_to(r, "fold/refixate/approach");
+    r.show_markers(12, 105, 250);
+    const long c0 = r.cycles();
+    REQUIRE(r.run_until([&] { return r.status().phase == SequenceStatus::aborted; }, 5000));
+    // The first frame within 66 cycles (15 Hz), then flap_seen_s of frames.
+    CHECK(r.cycles() - c0 >= 300);
+    CHECK(r.cycles() - c0 <= 300 + 66 + 2);
+    CHECK(r.status().abort_reason == static_cast<std::uint8_t>(Reason::fold_lost));
+    CHECK(std::string(r.status().why).find("the laid layer's printed face seen") !=
+          std::string::npos);
+    REQUIRE(r.run_to("aborted", 100000));
+  }
+  SUBCASE("seen for less than flap_seen_s: not yet") {
+    Rig r;
+    r.move_cycles = 600;
+    start_and_run_to(r, "fold/refixate/approach");
+    r.show_markers(12, 105, 250);
+    r.run(250);  // the first frame at most 66 cycles in: seen 184-250 ms
+    CHECK(r.status().phase != SequenceStatus::aborted);
+    r.show_markers(0, 0, 0);  // gone again: the count starts over
+    r.run(1000);
+    CHECK(r.status().phase != SequenceStatus::aborted);
+  }
+  SUBCASE("failing variants: on the near half, fewer than flap_seen_points, or before the lay") {
+    Rig near_half;
+    near_half.move_cycles = 600;
+    start_and_run_to(near_half, "fold/refixate/approach");
+    near_half.show_markers(40, 105, 60);  // the base's markers, beside the laid layer
+    REQUIRE(near_half.run_to("fold/swipe/approach"));
+    Rig few;
+    few.move_cycles = 600;
+    start_and_run_to(few, "fold/refixate/approach");
+    few.show_markers(9, 105, 250);
+    REQUIRE(few.run_to("fold/swipe/approach"));
+    Rig bend;
+    bend.move_cycles = 600;
+    start_and_run_to(bend, "fold/bend/follow_via[1]");
+    bend.show_markers(40, 105, 250);  // the lifted flap turns its printed face to the cameras
+    REQUIRE(bend.run_to("fold/bend/follow_via[5]"));
+  }
+}
+
 TEST_CASE("the diagonal fold runs from its file alone: its crease, its via points") {
   Rig r(fold_file("diagonal.yaml"), false);
   r.command(Command::start);

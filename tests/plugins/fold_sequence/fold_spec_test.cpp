@@ -87,6 +87,8 @@ TEST_CASE("the shipped folds load") {
   CHECK(h.pinch_lost_mm == 50.0);
   CHECK(h.pinch_lost_s == 0.3);
   CHECK(h.fold_lost_mm == 100.0);
+  CHECK(h.flap_seen_points == 10);  // the laid layer's printed face in view: it lies open
+  CHECK(h.flap_seen_s == 0.3);
   CHECK(h.release_stiffness[15] == doctest::Approx(0.5));  // the thumb soft while it opens
   CHECK(h.release_stiffness[3] == doctest::Approx(2.0));
   REQUIRE(h.grasp_above_via_count == 1);
@@ -111,6 +113,7 @@ TEST_CASE("the shipped folds load") {
   CHECK(d.pinch_lost_mm == 0.0);         // absent: not checked
   CHECK(d.pinch_lost_s == 0.0);
   CHECK(d.fold_lost_mm == 0.0);
+  CHECK(d.flap_seen_points == 0);  // not given: not checked
   CHECK(d.fold_line_mm[1][0] == 210.0);
   CHECK(d.via_count == 5);
   CHECK(d.shift_role == 0);  // absent: the fixing hand shifts and fixates where it pressed

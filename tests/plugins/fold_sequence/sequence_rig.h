@@ -96,7 +96,9 @@ class Rig {
   // and 21.5 mm short of where its shift puts it; else as it lay before, corner (0, 0) at
   // (-105, 148.5), u along +x.
   explicit Rig(const std::string& fold = half_fixing_shift(), bool turned = true)
-      : fold_(fold), sheet_(std::make_unique<SheetState>()) {
+      : fold_(fold),
+        sheet_(std::make_unique<SheetState>()),
+        keypoints_(std::make_unique<Keypoints>()) {
     plugin_ = make_plugin();
     for (int s = 0; s < 2; ++s) {
       const std::string x = s == 0 ? "r" : "l";
@@ -109,6 +111,7 @@ class Rig {
     crease_in_ = rig_ports_.queue_input<SheetCreaseEvent>("sheet_crease");
     memorize_in_ = rig_ports_.queue_input<SheetMemorizeEvent>("sheet_memorize");
     sheet_out_ = rig_ports_.latest_output<SheetState>("sheet_state", *sheet_);
+    keypoints_out_ = rig_ports_.latest_output<Keypoints>("keypoints", *keypoints_);
     status_in_ = rig_ports_.latest_input<SequenceStatus>("sequence_status");
     if (turned) {
       place_sheet(80, -170, true);
@@ -161,6 +164,18 @@ class Rig {
         s.normal[j * 3 + i][2] = -1;
         for (int c = 0; c < 3; ++c) flat_[j * 3 + i][c] = p[c];
       }
+  }
+  // Vision sees N markers' key-points (printed face) at sheet point (u, v) mm from now on, a
+  // frame every 66 cycles (15 Hz), stamped as taken; N 0: none.
+  void show_markers(std::uint32_t n, double u, double v) {
+    keypoints_->count = n;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      Keypoint& k = keypoints_->points[i];
+      k = Keypoint{};
+      k.sheet_mm[0] = static_cast<float>(u + 0.1 * i);
+      k.sheet_mm[1] = static_cast<float>(v);
+    }
+    keypoints_live_ = true;
   }
   // Node (i, j) of the tracked sheet to world (x, y, z) mm (a shape the model took).
   void set_node(int i, int j, double x, double y, double z) {
@@ -419,6 +434,11 @@ class Rig {
       sheet_->observations = observations;
       sheet_out_.write(*sheet_, now_);
     }
+    if (keypoints_live_ && n_ % 66 == 0) {
+      keypoints_->timestamp_ns = now_;
+      ++keypoints_->frame;
+      keypoints_out_.write(*keypoints_, now_);
+    }
   }
 
   void take() {
@@ -530,6 +550,8 @@ class Rig {
   PortBinder rig_ports_{registry_, "rig", {}, &flags_, nullptr};
   std::unique_ptr<FoldSequencePlugin> plugin_;
   std::unique_ptr<SheetState> sheet_;
+  std::unique_ptr<Keypoints> keypoints_;  // the frame vision sends from show_markers on
+  bool keypoints_live_ = false;
   int carried_ = -1;  // the node the pinch carries (carry()); -1: none yet
   std::array<std::array<float, 3>, 9> flat_{};  // where place_sheet laid each node
   bool carried_new_ = false;
@@ -543,6 +565,7 @@ class Rig {
   QueueInput<SheetCreaseEvent> crease_in_;
   QueueInput<SheetMemorizeEvent> memorize_in_;
   LatestOutput<SheetState> sheet_out_;
+  LatestOutput<Keypoints> keypoints_out_;
   LatestInput<SequenceStatus> status_in_;
   Arm arms_[2];
   Hand hands_[2];
