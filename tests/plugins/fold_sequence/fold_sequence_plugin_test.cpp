@@ -493,6 +493,8 @@ TEST_CASE(
     CHECK(std::string(r.status().why).find("the laid layer's printed face seen") !=
           std::string::npos);
     REQUIRE(r.run_to("aborted", 100000));
+    REQUIRE(crease::rt::alloc_hooks_installed());
+    CHECK(r.allocations() == 0);  // the key-points read and judged in the loop: no allocation
   }
   SUBCASE("seen for less than flap_seen_s: not yet") {
     Rig r;
