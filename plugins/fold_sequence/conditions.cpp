@@ -352,8 +352,14 @@ Reason Machine::grasp_off(const SheetState& sh, bool& judged) const noexcept {
   // Once the pinch let go (swipe from its withdraw on, harden), the laid layer is held by the
   // fixing hand alone and may spring back: the grasp point then lies far from where it was laid
   // (lay_mm's u, v on the stack, in the frame the lay's goal went out in).
-  const bool laid = (is_within(m_.leaf, S::swipe) && m_.leaf != S::swipe_release) ||
-                    is_within(m_.leaf, S::harden);
+  // From the swipe's stroke on, the stroke itself moves the laid layer (trials, 2026-12-06: a
+  // fold that held, 172 deg, its grasp point pushed over 100 mm towards the crease): where it was
+  // laid says nothing then, and with the printed-face check on (flap_seen_points) that alone
+  // judges the layer.
+  const bool stroked = m_.leaf == S::swipe_slide || is_within(m_.leaf, S::harden);
+  const bool laid = ((is_within(m_.leaf, S::swipe) && m_.leaf != S::swipe_release) ||
+                     is_within(m_.leaf, S::harden)) &&
+                    !(stroked && spec_.flap_seen_points > 0);
   judged = true;
   const bool checked =
       (m_.leaf == S::follow_via || lay) ? spec_.pinch_lost_mm > 0 : laid && spec_.fold_lost_mm > 0;

@@ -526,6 +526,32 @@ TEST_CASE(
   }
 }
 
+TEST_CASE(
+    "from the swipe's stroke on, the laid layer is judged by its printed face alone: the stroke "
+    "moves the grasp point away from where it was laid") {
+  // Trials (seeds 25, 29): the stroke towards the crease pushed a layer that stayed folded (172
+  // deg) over 100 mm from where it was laid, and the grasp point's bound aborted the fold.
+  Rig r;
+  r.move_cycles = 600;
+  start_and_run_to(r, "fold/swipe/slide");
+  r.spring_back();  // the tracked grasp point 250 mm or more from where it was laid
+  REQUIRE(r.run_to("fold/harden/approach", 400000));
+  // Before the stroke the same aborts (failing variant): the layer sprang back.
+  Rig before;
+  before.move_cycles = 600;
+  start_and_run_to(before, "fold/swipe/approach");
+  before.spring_back();
+  REQUIRE(before.run_until([&] { return before.status().phase == SequenceStatus::aborted; }));
+  CHECK(before.status().abort_reason == static_cast<std::uint8_t>(crease::fold::Reason::fold_lost));
+  // In the stroke the printed face still counts.
+  Rig seen;
+  seen.move_cycles = 600;
+  start_and_run_to(seen, "fold/swipe/slide");
+  seen.show_markers(12, 105, 250);
+  REQUIRE(seen.run_until([&] { return seen.status().phase == SequenceStatus::aborted; }));
+  CHECK(std::string(seen.status().why).find("printed face") != std::string::npos);
+}
+
 TEST_CASE("the diagonal fold runs from its file alone: its crease, its via points") {
   Rig r(fold_file("diagonal.yaml"), false);
   r.command(Command::start);
