@@ -433,11 +433,8 @@ bool Machine::flap_open(const Sensing& in) noexcept {
   // within a frame or two, where the model, held by the grasp and press targets, may keep the
   // layer laid for seconds.
   constexpr double kBeyondMm = 15.0;  // a model cell past the line: not the crease's own row
-  const S leaf = m_.leaf;
-  const bool laid = is_within(leaf, S::fixate_layer) || is_within(leaf, S::refixate) ||
-                    is_within(leaf, S::swipe) || is_within(leaf, S::harden);
   const Keypoints* k = in.keypoints;
-  if (spec_.flap_seen_points == 0 || !laid || k == nullptr ||
+  if (spec_.flap_seen_points == 0 || !layer_laid(m_.leaf) || k == nullptr ||
       !fresh(k->timestamp_ns, in.now_ns, spec_.sheet_max_age_s)) {
     m_.flap_seen_since_ns = 0;
     return false;

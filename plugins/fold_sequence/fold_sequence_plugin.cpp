@@ -71,10 +71,7 @@ Status FoldSequencePlugin::update(const Cycle& c) {
   }
   if (sheet_.has_value()) in.sheet = &sheet_.value();
   // The markers' key-points (16 kB) from the lay on, while the laid layer is judged by them.
-  const S leaf = machine_->memory().leaf;
-  if (is_within(leaf, S::fixate_layer) || is_within(leaf, S::refixate) ||
-      is_within(leaf, S::swipe) || is_within(leaf, S::harden))
-    (void)keypoints_.poll();
+  if (layer_laid(machine_->memory().leaf)) (void)keypoints_.poll();
   if (keypoints_.has_value()) in.keypoints = &keypoints_.value();
 
   Outbox& out = *outbox_;

@@ -119,16 +119,17 @@ bool part_point_under(const SheetState& s, const double a[2], const double b[2],
   const auto beyond = [&](double u, double v) { return beyond_line(a, b, side, u, v); };
   const double du = s.width_mm / (s.nodes_u - 1), dv = s.height_mm / (s.nodes_v - 1);
   int bi = -1, bj = -1;
-  double best = max_mm * max_mm;
+  double best = max_mm * max_mm, q[3] = {0, 0, 0};
   for (int j = 0; j < s.nodes_v; ++j)
     for (int i = 0; i < s.nodes_u; ++i) {
       if (beyond(i * du, j * dv) < 1.0) continue;
-      double q[3];
-      if (!node(s, i, j, q)) continue;
-      const double d2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]);
+      double n[3];
+      if (!node(s, i, j, n)) continue;
+      const double d2 = (n[0] - p[0]) * (n[0] - p[0]) + (n[1] - p[1]) * (n[1] - p[1]);
       if (d2 <= best) {
         best = d2;
         bi = i, bj = j;
+        for (int c = 0; c < 3; ++c) q[c] = n[c];
       }
     }
   if (bi < 0) return false;
@@ -136,8 +137,7 @@ bool part_point_under(const SheetState& s, const double a[2], const double b[2],
   uv[1] = bj * dv;
   // One linear step: the grid's world x, y per mm of u and of v at the node (central
   // differences, one-sided at the border), solved for the offset to P, at most one cell.
-  double q[3], e[2][2];
-  if (!node(s, bi, bj, q)) return false;
+  double e[2][2];
   for (int k = 0; k < 2; ++k) {
     const int n = k == 0 ? s.nodes_u : s.nodes_v, at = k == 0 ? bi : bj;
     const int lo = std::max(at - 1, 0), hi = std::min(at + 1, n - 1);

@@ -248,6 +248,11 @@ bool is_within(S s, S ancestor) noexcept {
   }
 }
 
+bool layer_laid(S s) noexcept {
+  return is_within(s, S::fixate_layer) || is_within(s, S::refixate) || is_within(s, S::swipe) ||
+         is_within(s, S::harden);
+}
+
 RowSpan all_rows() noexcept { return {kRows, kRows + kRowCount}; }
 
 RowSpan rows_of(S s) noexcept {

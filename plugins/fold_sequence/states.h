@@ -130,6 +130,9 @@ struct Row {
 [[nodiscard]] inline bool is_leaf(S s) noexcept { return state_info(s).initial == s; }
 [[nodiscard]] int depth(S s) noexcept;  // root 0, idle 1, fold/shift 2, ...
 [[nodiscard]] bool is_within(S s, S ancestor) noexcept;  // s == ancestor or below it
+// From the lay to the hardening's end (fixate_layer, refixate, swipe, harden): the bent layer lies
+// on the stack, its unprinted back to the cameras.
+[[nodiscard]] bool layer_laid(S s) noexcept;
 // The rows, every state's in table order; `rows_of` the ones of one state.
 struct RowSpan {
   const Row* begin;
