@@ -14,7 +14,7 @@
 // truth, from the fold's start. The tracker runs here without the loops' latency (a frame's
 // targets reach the model before its next step): the plugin test measures it in real loops.
 // Rendering is not timed. The machine is shared: times are noisy; both solvers run in turn.
-// Then (bench_depth_fused.cpp; --no-fused skips it) the printed sheet in the same loop: the five
+// Then (bench_depth_loop.cpp; --no-fused skips it) the printed sheet in the same loop: the five
 // colour cameras' key-points alone, and fused with the depth path (err_fused_mm).
 #include <algorithm>
 #include <cmath>
@@ -33,7 +33,7 @@
 #include "plugins/sim_world/scene/fold_script.h"
 #include "rt/clock.h"
 #include "tests/plugins/depth_tracking/dense_cpd_reference.h"
-#include "tools/bench/bench_depth_fused.h"
+#include "tools/bench/bench_depth_loop.h"
 
 using namespace crease;
 
@@ -234,10 +234,10 @@ int run_depth(int argc, char** argv) {
   char fused_mm[32] = "na";
   if (fused) {
     // The printed sheet: the five colour cameras' key-points alone, then with the depth path.
-    bench::FusedSetup fs;
+    bench::LoopSetup fs;
     fs.sheet = sp;
-    fs.script = &script;
-    fs.start_s = start_s;
+    fs.scene = bench::script_feed(script, sp, start_s);
+    fs.crease_s = start_s;
     fs.end_s = end_s;
     fs.depth = tp;
     const auto row = [](const char* what, const bench::TrackingError& e) {
@@ -247,9 +247,9 @@ int run_depth(int argc, char** argv) {
           "sets, %.0f key-points each\n",
           what, e.mean_mm, e.worst_mm, e.end_mm, e.keypoint_sets, e.keypoints_mean);
     };
-    const bench::TrackingError m = bench::track_printed_sheet(fs, false, true);
+    const bench::TrackingError m = bench::track_sheet(fs, false, true);
     row("markers alone:", m);
-    const bench::TrackingError md = bench::track_printed_sheet(fs, true, true);
+    const bench::TrackingError md = bench::track_sheet(fs, true, true);
     row("markers + depth:", md);
     std::snprintf(fused_mm, sizeof fused_mm, "%.2f", md.mean_mm);
   }
