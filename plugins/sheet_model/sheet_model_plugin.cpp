@@ -26,7 +26,9 @@
 // a depth target moves on at its node's velocity between the last two depth frames),
 // depth_tangential_weight (0.3: the share of the tangential error a depth target corrects),
 // depth_surface_normal (default true: a depth target pulls along the bisector of the model's
-// normal and the observed surface's, estimated from the targets of its grid neighbours).
+// normal and the observed surface's, estimated from the targets of its grid neighbours),
+// depth_hold_hidden_mm (1.5: paper under a laid flap that no depth target pulls keeps its place
+// on the table; 0: off).
 
 #include <memory>
 #include <string>
@@ -67,6 +69,8 @@ class SheetModelPlugin final : public Plugin {
     sp.solver.depth_along_normal = p.get<bool>("depth_along_normal", true);
     sp.solver.depth_tangential_weight = p.get_in_range<double>("depth_tangential_weight", 0.3, 0.0, 1.0);
     sp.solver.depth_surface_normal = p.get<bool>("depth_surface_normal", true);
+    sp.solver.depth_hold_hidden_mm =
+        p.get_in_range<double>("depth_hold_hidden_mm", 1.5, 0.0, 100.0);
     sp.solver.compliance_bending_m_per_n = p.get_in_range<double>("compliance_bending_m_per_n", 0.05, 0.0, 1e3);
     sp.solver.damping_per_s = p.get_in_range<double>("damping_per_s", 1.0, 0.0, 100.0);
     sp.solver.yield_strain = p.get_in_range<double>("yield_strain", sp.solver.yield_strain, 0.0, 1.0);

@@ -104,6 +104,11 @@ struct SolverParams {
   // normal alone, a flap that turns ahead of the model is pushed out along its tangent each frame
   // (its hinge rises off the crease); along the bisector the pull follows the chord of the turn.
   bool depth_surface_normal = true;
+  // While depth targets arrive: a node no depth target pulls, lying within this of the sheet's
+  // lowest node (on the table) and under another part of the sheet (a flap laid over it), keeps
+  // its place along the table (mm; 0: off). Hidden paper under a layer stays where it lay; the
+  // targets' pull on the rest of the sheet does not slide it.
+  double depth_hold_hidden_mm = 1.5;
   // Strain limiting (strain_limit.h): structural links longer than (1 + max_strain) x their rest
   // length are shortened to it after each substep's contacts, in strain_limit_sweeps sweeps.
   // 0: off (the tracking model follows what it sees); the simulated world's paper does not

@@ -71,6 +71,7 @@ XpbdSheet::XpbdSheet(const SheetParams& params) : SheetModel(params) {
   keep_.assign(3 * static_cast<std::size_t>(n), -1);
   touched_.assign(n, 0);
   unseen_.assign(n, 0);
+  hidden_held_.assign(n, 0);
   const SolverParams& s = params_.solver;
   if (s.plasticity_rate > 0) {
     for (int k = 0; k < link_count(); ++k)
@@ -244,6 +245,46 @@ void XpbdSheet::mark_unseen() noexcept {
     }
 }
 
+// The free nodes in no depth target's stencil lying within WITHIN_MM of the lowest node and
+// under another part of the sheet: a node at least kCoverCells grid cells away from it on the
+// sheet, above it by more than two thicknesses, within one node spacing of it across. A node
+// hidden only by something else (a hand) is left free: a finger may be sliding it.
+void XpbdSheet::mark_hidden_held(double within_mm) noexcept {
+  n_hidden_held_ = 0;
+  if (n_normal_targets_ == 0) return;
+  const int n = node_count();
+  const Grid& g = grid();
+  std::fill(touched_.begin(), touched_.end(), std::uint8_t{0});
+  for (int t = 0; t < n_normal_targets_; ++t)
+    for (int e = 0; e < 4; ++e)
+      if (normal_stencil_[t].bilinear[e] > 0) touched_[normal_stencil_[t].node[e]] = 1;
+  double low = 1e300;
+  for (int i = 0; i < n; ++i) low = std::min(low, x_[i].z);
+  const double across2 = std::max(g.du, g.dv) * std::max(g.du, g.dv);
+  const double above = 2.0 * params_.grid.thickness_mm;
+  constexpr int kCoverCells = 3;
+  for (int i = 0; i < n; ++i) {
+    if (touched_[i] || pinned_[i] || x_[i].z > low + within_mm) continue;
+    const int ii = i % g.w, ij = i / g.w;
+    bool covered = false;
+    for (int k = 0; k < n && !covered; ++k) {
+      if (std::abs(k % g.w - ii) < kCoverCells && std::abs(k / g.w - ij) < kCoverCells) continue;
+      const double dx = x_[k].x - x_[i].x, dy = x_[k].y - x_[i].y;
+      covered = x_[k].z - x_[i].z > above && dx * dx + dy * dy <= across2;
+    }
+    if (covered) hidden_held_[n_hidden_held_++] = i;
+  }
+}
+
+// After the substep's contacts: the held nodes back to where they were along the table.
+void XpbdSheet::hold_hidden() noexcept {
+  for (int k = 0; k < n_hidden_held_; ++k) {
+    const int i = hidden_held_[k];
+    x_[i].x = prev_[i].x;
+    x_[i].y = prev_[i].y;
+  }
+}
+
 // As the speed limit of update_velocities_rt, with the unseen nodes' own limit.
 void XpbdSheet::limit_unseen(double dts) noexcept {
   const double cap = unseen_speed_limit_;
@@ -296,6 +337,8 @@ void XpbdSheet::step_rt(double dt) noexcept {
   prepare_normal_targets(dts);
   const bool limit_unseen_nodes = unseen_speed_limit_ > 0 && std::isfinite(unseen_speed_limit_);
   if (limit_unseen_nodes) mark_unseen();
+  n_hidden_held_ = 0;
+  if (sp.depth_hold_hidden_mm > 0) mark_hidden_held(sp.depth_hold_hidden_mm);
   detect_contacts(dt);
 
   const double damp = std::max(0.0, 1.0 - sp.damping_per_s * dts);
@@ -316,6 +359,7 @@ void XpbdSheet::step_rt(double dt) noexcept {
     }
     const int every = std::max(1, sp.self_collision_every);
     contacts_.solve_rt(x_, prev_, w_, s % every == every - 1 || s == ns - 1);
+    hold_hidden();
     update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit
     if (limit_unseen_nodes) limit_unseen(dts);
     ++substeps_done_;

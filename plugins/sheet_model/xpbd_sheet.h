@@ -64,6 +64,8 @@ class XpbdSheet final : public SheetModel {
   void update_plasticity() noexcept;
   void mark_unseen() noexcept;
   void limit_unseen(double dts) noexcept;
+  void mark_hidden_held(double within_mm) noexcept;
+  void hold_hidden() noexcept;
   void detect_contacts(double dt_s) noexcept;
 
   std::vector<Vec3> x_, v_, prev_;
@@ -94,6 +96,8 @@ class XpbdSheet final : public SheetModel {
   std::vector<std::uint8_t> touched_;        // per node: in a target's or key-point's stencil
   std::vector<std::int32_t> unseen_;         // the free nodes not touched (this frame)
   int n_unseen_ = 0;
+  std::vector<std::int32_t> hidden_held_;  // depth_hold_hidden_mm: the nodes held (this frame)
+  int n_hidden_held_ = 0;
   std::uint64_t substeps_done_ = 0;          // since construction (plasticity_every counts them)
   SubstepContacts* substep_contacts_ = nullptr;
   ContactSolver contacts_;
