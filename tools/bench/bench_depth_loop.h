@@ -46,7 +46,7 @@ struct SceneAt {
 // Fills the scene at T_S (s); successive calls never go back in time.
 using SceneFeed = std::function<void(double t_s, SceneAt& out)>;
 
-// The fold script's sheet (the model's own grid), no robot.
+// The fold script's sheet (the model's own grid), no robot. SCRIPT is kept by reference.
 [[nodiscard]] SceneFeed script_feed(const sheet::FoldScript& script, const sheet::SheetParams& sp,
                                     double start_s);
 
