@@ -152,17 +152,29 @@ void targets_at(const SheetParams& p, std::span<const Vec3> pos,
     }
 }
 
+// A sheet model on the table at z = 0 with 3-D depth springs and the hold at HOLD_MM.
+struct HoldRig {
+  SheetParams p;
+  SheetRunner r;
+  std::unique_ptr<crease::SheetState> st = std::make_unique<crease::SheetState>();
+  std::unique_ptr<crease::DepthTargets> t = std::make_unique<crease::DepthTargets>();
+  int W = 0, H = 0;
+  static SheetParams params(double hold_mm) {
+    SheetParams p;
+    p.solver.depth_along_normal = false;
+    p.solver.depth_hold_hidden_mm = hold_mm;
+    return p;
+  }
+  explicit HoldRig(double hold_mm)
+      : p(params(hold_mm)), r(p, 0.0), W(p.grid.nodes_u), H(p.grid.nodes_v) {}
+};
+
 // The half fold's flap (v < h/2) led over by targets (the fold script, 5 s to 175 deg, held 3 s),
 // then dragged 15 mm along +x in 1 s: how far the lower layer's far rows (under the flap, no
 // target) move along x in that second (mm, mean).
 double lower_layer_drag(double hold_mm) {
-  SheetParams p;
-  p.solver.depth_along_normal = false;
-  p.solver.depth_hold_hidden_mm = hold_mm;
-  SheetRunner r(p, 0.0);
-  auto st = std::make_unique<crease::SheetState>();
-  auto t = std::make_unique<crease::DepthTargets>();
-  const int W = p.grid.nodes_u, H = p.grid.nodes_v;
+  HoldRig rig(hold_mm);
+  auto& [p, r, st, t, W, H] = rig;
   const auto script = FoldScript::half_fold(p.grid);
   std::vector<Vec3> pos(static_cast<std::size_t>(W * H));
   crease::SheetCreaseEvent crease;
@@ -197,13 +209,8 @@ double lower_layer_drag(double hold_mm) {
 // A flat sheet on the table, targets on every node but a 3 x 3 patch (a hand over it), all moved
 // 15 mm along +x in 1 s: how far the patch moves along x (mm, mean).
 double hand_hidden_patch_drag(double hold_mm) {
-  SheetParams p;
-  p.solver.depth_along_normal = false;
-  p.solver.depth_hold_hidden_mm = hold_mm;
-  SheetRunner r(p, 0.0);
-  auto st = std::make_unique<crease::SheetState>();
-  auto t = std::make_unique<crease::DepthTargets>();
-  const int W = p.grid.nodes_u, H = p.grid.nodes_v;
+  HoldRig rig(hold_mm);
+  auto& [p, r, st, t, W, H] = rig;
   const std::vector<Vec3> flat(r.model().positions().begin(), r.model().positions().end());
   const auto in_patch = [W, H](int i, int j) {
     return std::abs(i - W / 2) <= 1 && std::abs(j - H / 2) <= 1;
