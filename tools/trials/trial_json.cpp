@@ -12,69 +12,76 @@ nlohmann::json num(double v) {
 double num(const nlohmann::json& j) {
   return j.is_number() ? j.get<double>() : std::nan("");
 }
+nlohmann::json value(double v) {
+  return num(v);
+}
+nlohmann::json value(long v) {
+  return v;
+}
+nlohmann::json value(int v) {
+  return v;
+}
+void read(const nlohmann::json& j, double& v) {
+  v = num(j);
+}
+void read(const nlohmann::json& j, long& v) {
+  v = j.get<long>();
+}
+void read(const nlohmann::json& j, int& v) {
+  v = j.get<int>();
+}
+
+// The series' value columns beside its time axis "t_s", each once: f(group, name, field) for
+// every field of sample X (a SeriesSample, const when written). A column is read when its group's
+// first column is in the file (results written before the group: the sample's defaults), and then
+// must be there; the first group ("t_s") always.
+template <class Sample, class F>
+void for_each_column(Sample& x, F&& f) {
+  f("t_s", "force_r_n", x.force_n[0]);
+  f("t_s", "force_l_n", x.force_n[1]);
+  f("t_s", "stretch", x.stretch);
+  f("measured_r_n", "measured_r_n", x.measured_n[0]);
+  f("measured_l_n", "measured_l_n", x.measured_n[1]);
+  f("tip_r", "tip_r", x.force_tip[0]);
+  f("tip_r", "tip_l", x.force_tip[1]);
+  f("tip_r", "tip_r_z_mm", x.force_tip_z_mm[0]);
+  f("tip_r", "tip_l_z_mm", x.force_tip_z_mm[1]);
+  f("frame_mm", "frame_mm", x.frame_err_mm);
+  f("frame_moved_mm", "frame_moved_mm", x.frame_moved_mm);
+  f("ff_r_z_mm", "ff_r_z_mm", x.ff_z_mm[0]);
+  f("ff_r_z_mm", "ff_l_z_mm", x.ff_z_mm[1]);
+  f("palm_r", "palm_r", x.palm_contact[0]);
+  f("palm_r", "palm_l", x.palm_contact[1]);
+  f("palm_r", "wrist_r_deg", x.wrist_deflection_deg[0]);
+  f("palm_r", "wrist_l_deg", x.wrist_deflection_deg[1]);
+  f("grasp_z_mm", "grasp_z_mm", x.grasp_z_mm);
+  f("grasp_z_mm", "grasp_tracked_z_mm", x.grasp_tracked_z_mm);
+  f("grasp_off_mm", "grasp_off_mm", x.grasp_off_mm);
+  f("grasp_off_mm", "observations", x.observations);
+  f("contact_r", "contact_r", x.contact_fingers[0]);
+  f("contact_r", "contact_l", x.contact_fingers[1]);
+  f("contact_r", "onsets_r", x.contact_onsets[0]);
+  f("contact_r", "onsets_l", x.contact_onsets[1]);
+}
 }  // namespace
 
 nlohmann::json to_json(const TrialResult& r) {
   nlohmann::json timeline = nlohmann::json::array();
   for (const auto& e : r.timeline)
     timeline.push_back({{"t_s", e.t_s}, {"path", e.path}, {"why", e.why}});
-  nlohmann::json series = {{"t_s", nlohmann::json::array()},
-                           {"force_r_n", nlohmann::json::array()},
-                           {"force_l_n", nlohmann::json::array()},
-                           {"stretch", nlohmann::json::array()},
-                           {"measured_r_n", nlohmann::json::array()},
-                           {"measured_l_n", nlohmann::json::array()},
-                           {"tip_r", nlohmann::json::array()},
-                           {"tip_l", nlohmann::json::array()},
-                           {"tip_r_z_mm", nlohmann::json::array()},
-                           {"tip_l_z_mm", nlohmann::json::array()},
-                           {"contact_r", nlohmann::json::array()},
-                           {"contact_l", nlohmann::json::array()},
-                           {"onsets_r", nlohmann::json::array()},
-                           {"onsets_l", nlohmann::json::array()},
-                           {"frame_mm", nlohmann::json::array()},
-                           {"grasp_z_mm", nlohmann::json::array()},
-                           {"grasp_tracked_z_mm", nlohmann::json::array()},
-                           {"grasp_off_mm", nlohmann::json::array()},
-                           {"observations", nlohmann::json::array()},
-                           {"frame_moved_mm", nlohmann::json::array()},
-                           {"ff_r_z_mm", nlohmann::json::array()},
-                           {"ff_l_z_mm", nlohmann::json::array()},
-                           {"palm_r", nlohmann::json::array()},
-                           {"palm_l", nlohmann::json::array()},
-                           {"wrist_r_deg", nlohmann::json::array()},
-                           {"wrist_l_deg", nlohmann::json::array()}};
+  nlohmann::json series = {{"t_s", nlohmann::json::array()}};
+  const SeriesSample none;
+  for_each_column(none, [&](const char*, const char* name, const auto&) {
+    series[name] = nlohmann::json::array();
+  });
   nlohmann::json sheet_end = {{"nodes_u", r.sheet_nodes_u},
                               {"nodes_v", r.sheet_nodes_v},
                               {"position_mm", nlohmann::json::array()}};
   for (const auto& p : r.sheet_end_mm) sheet_end["position_mm"].push_back({p[0], p[1], p[2]});
   for (const auto& x : r.series) {
     series["t_s"].push_back(x.t_s);
-    series["force_r_n"].push_back(num(x.force_n[0]));
-    series["force_l_n"].push_back(num(x.force_n[1]));
-    series["stretch"].push_back(num(x.stretch));
-    series["measured_r_n"].push_back(num(x.measured_n[0]));
-    series["measured_l_n"].push_back(num(x.measured_n[1]));
-    series["tip_r"].push_back(x.force_tip[0]);
-    series["tip_l"].push_back(x.force_tip[1]);
-    series["tip_r_z_mm"].push_back(num(x.force_tip_z_mm[0]));
-    series["tip_l_z_mm"].push_back(num(x.force_tip_z_mm[1]));
-    series["contact_r"].push_back(x.contact_fingers[0]);
-    series["contact_l"].push_back(x.contact_fingers[1]);
-    series["frame_mm"].push_back(num(x.frame_err_mm));
-    series["frame_moved_mm"].push_back(num(x.frame_moved_mm));
-    series["ff_r_z_mm"].push_back(num(x.ff_z_mm[0]));
-    series["ff_l_z_mm"].push_back(num(x.ff_z_mm[1]));
-    series["palm_r"].push_back(x.palm_contact[0]);
-    series["palm_l"].push_back(x.palm_contact[1]);
-    series["wrist_r_deg"].push_back(num(x.wrist_deflection_deg[0]));
-    series["wrist_l_deg"].push_back(num(x.wrist_deflection_deg[1]));
-    series["grasp_z_mm"].push_back(num(x.grasp_z_mm));
-    series["grasp_tracked_z_mm"].push_back(num(x.grasp_tracked_z_mm));
-    series["grasp_off_mm"].push_back(num(x.grasp_off_mm));
-    series["observations"].push_back(x.observations);
-    series["onsets_r"].push_back(x.contact_onsets[0]);
-    series["onsets_l"].push_back(x.contact_onsets[1]);
+    for_each_column(
+        x, [&](const char*, const char* name, const auto& v) { series[name].push_back(value(v)); });
   }
   const Score& s = r.score;
   return {{"trial", r.index},
@@ -162,43 +169,11 @@ TrialResult from_json(const nlohmann::json& j) {
   if (j.contains("series")) {
     const auto& x = j.at("series");
     for (std::size_t k = 0; k < x.at("t_s").size(); ++k) {
-      SeriesSample v{x.at("t_s")[k].get<double>(),
-                     {num(x.at("force_r_n")[k]), num(x.at("force_l_n")[k])},
-                     num(x.at("stretch")[k])};
-      if (x.contains("measured_r_n")) v.measured_n[0] = num(x.at("measured_r_n")[k]);
-      if (x.contains("measured_l_n")) v.measured_n[1] = num(x.at("measured_l_n")[k]);
-      if (x.contains("tip_r")) {
-        v.force_tip[0] = x.at("tip_r")[k].get<int>();
-        v.force_tip[1] = x.at("tip_l")[k].get<int>();
-        v.force_tip_z_mm[0] = num(x.at("tip_r_z_mm")[k]);
-        v.force_tip_z_mm[1] = num(x.at("tip_l_z_mm")[k]);
-      }
-      if (x.contains("frame_mm")) v.frame_err_mm = num(x.at("frame_mm")[k]);
-      if (x.contains("frame_moved_mm")) v.frame_moved_mm = num(x.at("frame_moved_mm")[k]);
-      if (x.contains("ff_r_z_mm")) {
-        v.ff_z_mm[0] = num(x.at("ff_r_z_mm")[k]);
-        v.ff_z_mm[1] = num(x.at("ff_l_z_mm")[k]);
-      }
-      if (x.contains("palm_r")) {
-        v.palm_contact[0] = x.at("palm_r")[k].get<int>();
-        v.palm_contact[1] = x.at("palm_l")[k].get<int>();
-        v.wrist_deflection_deg[0] = num(x.at("wrist_r_deg")[k]);
-        v.wrist_deflection_deg[1] = num(x.at("wrist_l_deg")[k]);
-      }
-      if (x.contains("grasp_z_mm")) {
-        v.grasp_z_mm = num(x.at("grasp_z_mm")[k]);
-        v.grasp_tracked_z_mm = num(x.at("grasp_tracked_z_mm")[k]);
-      }
-      if (x.contains("grasp_off_mm")) {
-        v.grasp_off_mm = num(x.at("grasp_off_mm")[k]);
-        v.observations = x.at("observations")[k].get<long>();
-      }
-      if (x.contains("contact_r")) {
-        v.contact_fingers[0] = x.at("contact_r")[k].get<int>();
-        v.contact_fingers[1] = x.at("contact_l")[k].get<int>();
-        v.contact_onsets[0] = x.at("onsets_r")[k].get<long>();
-        v.contact_onsets[1] = x.at("onsets_l")[k].get<long>();
-      }
+      SeriesSample v;
+      v.t_s = x.at("t_s")[k].get<double>();
+      for_each_column(v, [&](const char* group, const char* name, auto& field) {
+        if (x.contains(group)) read(x.at(name)[k], field);
+      });
       r.series.push_back(v);
     }
   }
