@@ -250,8 +250,7 @@ void XpbdSheet::mark_unseen() noexcept {
 // sheet, above it by more than two thicknesses, within one node spacing of it across. A node
 // hidden only by something else (a hand) is left free: a finger may be sliding it.
 void XpbdSheet::mark_hidden_held(double within_mm) noexcept {
-  n_hidden_held_ = 0;
-  if (n_normal_targets_ == 0) return;
+  if (n_normal_targets_ == 0) return;  // step_rt emptied the list
   const int n = node_count();
   const Grid& g = grid();
   std::fill(touched_.begin(), touched_.end(), std::uint8_t{0});

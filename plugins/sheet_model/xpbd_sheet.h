@@ -93,7 +93,9 @@ class XpbdSheet final : public SheetModel {
   std::uint64_t prepared_version_ = ~std::uint64_t{0};
   double prepared_dt_ = 0.0;
   std::vector<std::int32_t> plastic_links_;  // elasto-plastic links
-  std::vector<std::uint8_t> touched_;        // per node: in a target's or key-point's stencil
+  // Per node, this frame's scratch: in a target's or key-point's stencil (mark_unseen), then in a
+  // depth target's (mark_hidden_held).
+  std::vector<std::uint8_t> touched_;
   std::vector<std::int32_t> unseen_;         // the free nodes not touched (this frame)
   int n_unseen_ = 0;
   std::vector<std::int32_t> hidden_held_;  // depth_hold_hidden_mm: the nodes held (this frame)

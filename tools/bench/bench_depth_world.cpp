@@ -18,7 +18,9 @@
 // model is not told the fold's crease. --no-grasp: nor where the pinch holds the sheet (by
 // default, as the folding sequence does, the grasp point at the pinching hand while it holds).
 // Last line: depth_world: err_mm=... worst_mm=... blind_mm=... err_markers_mm=... err_fused_mm=...
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
