@@ -140,9 +140,13 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
           const int node = cell_nodes_[e];
           const Vec3& p = x[node];
           if (p.x < bl[0] || p.x > bh[0] || p.y < bl[1] || p.y > bh[1] || p.z < bl[2] || p.z > bh[2]) continue;
-          // The patch reaches up to half a diagonal of a cell from the node.
-          const double patch = 0.5 * std::hypot(du_, dv_);
-          if (closest_surface(sh.geom, sh.pose1, p).distance_mm > reach_s + sweep + patch) continue;
+          // The patch reaches up to half a diagonal of a cell from the node; the node's distance
+          // from the core less the shape's growth bounds its distance from the shape from below
+          // (exactly but for a cylinder, which lies within it).
+          const Vec3 xl = sh.pose1.inverse_apply(p);
+          if (norm(closest_core_local(sh.geom, xl) - xl) - core_grow(sh.geom) >
+              reach_s + sweep + patch_reach_)
+            continue;
           int slot = slot_of_node_[node];
           if (slot < 0) {
             slot = n_touched_++;
@@ -176,30 +180,37 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
 
 double FingerContacts::max_push_mm(double) const noexcept { return n_touched_ > 0 ? max_push_mm_ : 0.0; }
 
-Vec3 FingerContacts::deepest_patch_point(const WorldShape& s, const Pose& pose, const Touched& t, Vec3 x) const noexcept {
-  Vec3 q = x;
+double FingerContacts::patch_distance_bound(const WorldShape& s, Vec3 x_local) const noexcept {
+  return norm(closest_core_local(s.geom, x_local) - x_local) - core_grow(s.geom) - patch_reach_;
+}
+
+Vec3 FingerContacts::deepest_patch_point(const WorldShape& s, const Touched& t,
+                                         const Local& l) noexcept {
+  Vec3 q = l.x;
   for (int it = 0; it < 3; ++it) {
-    const Vec3 d = closest_core(s.geom, pose, q) - x;
-    const double pu = std::clamp(dot(d, t.eu), t.ulo, t.uhi), pv = std::clamp(dot(d, t.ev), t.vlo, t.vhi);
-    q = x + pu * t.eu + pv * t.ev;
+    const Vec3 d = closest_core_local(s.geom, q) - l.x;
+    const double pu = std::clamp(dot(d, l.eu), t.ulo, t.uhi),
+                 pv = std::clamp(dot(d, l.ev), t.vlo, t.vhi);
+    q = l.x + pu * l.eu + pv * l.ev;
   }
   return q;
 }
 
-FingerContacts::Geometry FingerContacts::geometry(const WorldShape& s, const Pose& pose, const Touched& t,
-                                                  Vec3 x) const noexcept {
-  const Vec3 q = deepest_patch_point(s, pose, t, x);
-  const SurfacePoint sp = closest_surface(s.geom, pose, q);
+FingerContacts::Geometry FingerContacts::geometry(const WorldShape& s, const Pose& pose,
+                                                  const Touched& t, const Local& l) const noexcept {
+  const Vec3 q = deepest_patch_point(s, t, l);
+  const SurfacePoint sp = closest_surface_local(s.geom, q);
+  const Vec3 normal = pose.rotate(sp.normal);
   Geometry g;
-  g.point = sp.point;
+  g.point = pose.apply(sp.point);
   g.pen = half_thickness_ - sp.distance_mm;
-  const double c = dot(sp.normal, t.en);
+  const double c = dot(normal, t.en);
   constexpr double kFaceOn = 0.5;  // cos 60 deg
   if (std::fabs(c) >= kFaceOn) {
     g.n = c > 0 ? t.en : -1.0 * t.en;
     g.pen /= std::fabs(c);
   } else {
-    g.n = sp.normal;
+    g.n = normal;
   }
   return g;
 }
@@ -233,9 +244,9 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
     // world's scenes): a lower bound on the patch's distance from the shape (the node's from the
     // core, less the shape's growth and the patch's reach) rules most of those out before the
     // patch's deepest point is sought (three core projections and a surface query).
-    if (norm(closest_core(s.geom, pose, p) - p) - core_grow(s.geom) - patch_reach_ >= half_thickness_ + kInactiveReachMm)
-      continue;
-    const Geometry geo = geometry(s, pose, t, p);
+    const Vec3 xl = pose.inverse_apply(p);
+    if (patch_distance_bound(s, xl) >= half_thickness_ + kInactiveReachMm) continue;
+    const Geometry geo = geometry(s, pose, t, to_local(pose, t, xl));
     if (geo.pen <= -kInactiveReachMm) continue;
     // Shapes of one rigid body (a fingertip's cover, pad and back) overlap: a node inside two
     // of them leaves through the nearer surface, never gets squeezed between them.
@@ -425,7 +436,25 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
     const bool held = p.z <= held_z && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3];
     Geometry geo[kMaxShapesPerNode];
     bool used[kMaxShapesPerNode] = {};
-    for (int s = 0; s < t.n_shapes; ++s) geo[s] = geometry(shapes_[t.shape[s]], poses[t.shape[s]], t, p);
+    // A pair is listed only within kGapMm + its springback; most candidates are further (the
+    // candidates reach the step's sweep as well). The lower bound of gather_rt rules those out
+    // before the deepest patch point is sought; a pair ruled out is given a depth below every
+    // listed pair's threshold on this node, so that it neither is listed nor wins an exit.
+    double springback_max = 0;
+    for (int s = 0; s < t.n_shapes; ++s)
+      springback_max = std::max(springback_max, springback_mm_[t.shape[s]]);
+    const double far_below = -(kGapMm + springback_max);
+    for (int s = 0; s < t.n_shapes; ++s) {
+      const WorldShape& sh = shapes_[t.shape[s]];
+      const Pose& pose = poses[t.shape[s]];
+      const Vec3 xl = pose.inverse_apply(p);
+      if (half_thickness_ - patch_distance_bound(sh, xl) <= far_below) {
+        geo[s] = Geometry{};
+        geo[s].pen = -1e300;
+        continue;
+      }
+      geo[s] = geometry(sh, pose, t, to_local(pose, t, xl));
+    }
     for (int s = 0; s < t.n_shapes; ++s)  // one contact per rigid body (see gather_rt)
       for (int o = 0; o < t.n_shapes; ++o) {
         const WorldShape &a = shapes_[t.shape[s]], &b = shapes_[t.shape[o]];

@@ -144,8 +144,20 @@ class FingerContacts final : public sheet::SubstepContacts {
     double pen = 0;   // how far along n until it clears the shape by half the thickness (mm)
     Vec3 point;       // the shape's surface point
   };
-  [[nodiscard]] Vec3 deepest_patch_point(const WorldShape& s, const Pose& pose, const Touched& t, Vec3 x) const noexcept;
-  [[nodiscard]] Geometry geometry(const WorldShape& s, const Pose& pose, const Touched& t, Vec3 x) const noexcept;
+  // The node at x in a shape's frame (the queries below work there: one transform in, two out).
+  struct Local {
+    Vec3 x, eu, ev;  // the node, its patch's tangent axes
+  };
+  [[nodiscard]] static Local to_local(const Pose& pose, const Touched& t, Vec3 x_local) noexcept {
+    return {x_local, pose.inverse_rotate(t.eu), pose.inverse_rotate(t.ev)};
+  }
+  // A lower bound on the distance of the node's patch from the shape (mm): the node's from the
+  // core, less the shape's growth and the patch's reach.
+  [[nodiscard]] double patch_distance_bound(const WorldShape& s, Vec3 x_local) const noexcept;
+  [[nodiscard]] static Vec3 deepest_patch_point(const WorldShape& s, const Touched& t,
+                                                const Local& l) noexcept;
+  [[nodiscard]] Geometry geometry(const WorldShape& s, const Pose& pose, const Touched& t,
+                                  const Local& l) const noexcept;
   int gather_rt(const Touched& t, Vec3 p, double dt_s, Contact* c, bool& any) const noexcept;
   static Vec3 normal_rt(Contact* c, int m, double w) noexcept;
   static Vec3 friction_rt(const Contact* c, int m, double w, double dt_s, Vec3 u0, Vec3* fric_on_node) noexcept;

@@ -35,6 +35,10 @@ struct Pose {
     return {r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
             r[2] * d.x + r[5] * d.y + r[8] * d.z};
   }
+  [[nodiscard]] Vec3 inverse_rotate(Vec3 d) const noexcept {  // R^T d
+    return {r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
+            r[2] * d.x + r[5] * d.y + r[8] * d.z};
+  }
   [[nodiscard]] Vec3 axis(int c) const noexcept { return {r[c], r[3 + c], r[6 + c]}; }
 };
 
@@ -62,9 +66,9 @@ inline Vec3 fallback_normal(const Pose& pose) noexcept { return pose.axis(0); }
 
 }  // namespace detail
 
-// Signed distance of world point p from the shape's surface. RT.
-inline SurfacePoint closest_surface(const Geom& g, const Pose& pose, Vec3 p) noexcept {
-  const Vec3 l = pose.inverse_apply(p);
+// Signed distance of point l from the shape's surface, all in the shape's frame (point and
+// normal too). RT.
+inline SurfacePoint closest_surface_local(const Geom& g, Vec3 l) noexcept {
   SurfacePoint out;
   Vec3 n_local, s_local;
   switch (g.kind) {
@@ -122,8 +126,16 @@ inline SurfacePoint closest_surface(const Geom& g, const Pose& pose, Vec3 p) noe
       break;
     }
   }
-  out.point = pose.apply(s_local);
-  out.normal = pose.rotate(n_local);
+  out.point = s_local;
+  out.normal = n_local;
+  return out;
+}
+
+// Signed distance of world point p from the shape's surface. RT.
+inline SurfacePoint closest_surface(const Geom& g, const Pose& pose, Vec3 p) noexcept {
+  SurfacePoint out = closest_surface_local(g, pose.inverse_apply(p));
+  out.point = pose.apply(out.point);
+  out.normal = pose.rotate(out.normal);
   return out;
 }
 
@@ -131,8 +143,8 @@ inline SurfacePoint closest_surface(const Geom& g, const Pose& pose, Vec3 p) noe
 // point of a capsule's or cylinder's axis segment, the nearest point of a box shrunk by its
 // smallest half extent on every axis. The shape is that core grown (exactly for a sphere or a
 // capsule), so the deepest point of a flat patch under the shape lies below its core. RT.
-inline Vec3 closest_core(const Geom& g, const Pose& pose, Vec3 p) noexcept {
-  const Vec3 l = pose.inverse_apply(p);
+inline Vec3 closest_core_local(const Geom& g,
+                               Vec3 l) noexcept {  // l and the result in the shape's frame
   Vec3 c;
   switch (g.kind) {
     case GeomKind::sphere:
@@ -148,7 +160,10 @@ inline Vec3 closest_core(const Geom& g, const Pose& pose, Vec3 p) noexcept {
       break;
     }
   }
-  return pose.apply(c);
+  return c;
+}
+inline Vec3 closest_core(const Geom& g, const Pose& pose, Vec3 p) noexcept {
+  return pose.apply(closest_core_local(g, pose.inverse_apply(p)));
 }
 
 // How far the shape reaches beyond its core (closest_core): |p - core| minus it is a lower bound
