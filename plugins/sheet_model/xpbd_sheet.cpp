@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "collision_world.h"
 #include "node_passes.h"
@@ -204,11 +205,19 @@ void XpbdSheet::project_normal_targets() noexcept {
   }
 }
 
-void XpbdSheet::update_plasticity() noexcept {
+void XpbdSheet::update_plasticity(int every) noexcept {
   const double a = params_.solver.plasticity_rate;
   const double eps_y = params_.solver.yield_strain;
+  // One EVERY-th of the links after each substep, interleaved (positions phase, phase + every,
+  // ...): each link every EVERY substeps, and no substep pays for all of them at once (the
+  // world's step had a spike every 10 ms). Contiguous chunks instead moved sim_world_fold's
+  // from-beyond fold by 10 mm (a chaotic scene); interleaved, by 0.1 mm.
+  const auto n = static_cast<std::ptrdiff_t>(plastic_links_.size());
+  const std::ptrdiff_t phase = plastic_cursor_ % every;
+  plastic_cursor_ = (phase + 1) % every;
   bool changed = false;
-  for (const std::int32_t k : plastic_links_) {
+  for (std::ptrdiff_t e = phase; e < n; e += every) {
+    const std::int32_t k = plastic_links_[e];
     const double l = rest_[k];
     const double dl = norm(x_[topo_.b[k]] - x_[topo_.a[k]]) - l;
     const double p = plastic_update(dl, plastic_[k], a, eps_y * l);
@@ -342,7 +351,7 @@ void XpbdSheet::step_rt(double dt) noexcept {
 
   const double damp = std::max(0.0, 1.0 - sp.damping_per_s * dts);
   const double vcap = sp.max_speed_mm_per_s;
-  const auto plastic_every = static_cast<std::uint64_t>(std::max(1, sp.plasticity_every));
+  const int plastic_every = std::max(1, sp.plasticity_every);
   for (int s = 0; s < ns; ++s) {
     // seed 000 Eqs. 1-4 (keypoint_coupling.h)
     (void)coupling_.apply_rt(keypoints(), keypoint_stencils(), keypoint_gain_, dts, x_, v_, pinned_);
@@ -362,7 +371,7 @@ void XpbdSheet::step_rt(double dt) noexcept {
     update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit
     if (limit_unseen_nodes) limit_unseen(dts);
     ++substeps_done_;
-    if (links_learn_ && !plastic_links_.empty() && substeps_done_ % plastic_every == 0) update_plasticity();
+    if (links_learn_ && !plastic_links_.empty()) update_plasticity(plastic_every);
   }
   (void)infer_creases_rt();  // solver.crease_strain > 0 only; the next frame re-reads the links
 }

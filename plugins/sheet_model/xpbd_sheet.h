@@ -7,7 +7,8 @@
 //   solver.max_strain > 0 only; the external contacts' holds) -> contacts (table, shapes;
 //   layers every
 //   solver.self_collision_every substeps and on the last) -> velocities from positions ->
-//   plastic update (seed 001 III.C; every solver.plasticity_every substeps).
+//   plastic update (seed 001 III.C; each substep one solver.plasticity_every-th of the links,
+//   in turn, so each link every plasticity_every substeps).
 // Link constants are rebuilt only when links_version() or dt_s change; target-spring
 // weights once per frame (rows interleaved so consecutive ones seldom share a node).
 // Contacts: candidates are detected with a margin that also covers a skin of motion (and,
@@ -61,7 +62,7 @@ class XpbdSheet final : public SheetModel {
   void project_targets() noexcept;
   void prepare_normal_targets(double dt_s) noexcept;
   void project_normal_targets() noexcept;
-  void update_plasticity() noexcept;
+  void update_plasticity(int every) noexcept;  // the next EVERY-th of plastic_links_, interleaved
   void mark_unseen() noexcept;
   void limit_unseen(double dts) noexcept;
   void mark_hidden_held(double within_mm) noexcept;
@@ -100,7 +101,8 @@ class XpbdSheet final : public SheetModel {
   int n_unseen_ = 0;
   std::vector<std::int32_t> hidden_held_;  // depth_hold_hidden_mm: the nodes held (this frame)
   int n_hidden_held_ = 0;
-  std::uint64_t substeps_done_ = 0;          // since construction (plasticity_every counts them)
+  std::uint64_t substeps_done_ = 0;    // since construction
+  std::ptrdiff_t plastic_cursor_ = 0;  // update_plasticity's next turn, 0 .. every - 1
   SubstepContacts* substep_contacts_ = nullptr;
   ContactSolver contacts_;
   StrainLimit strain_limit_;

@@ -187,10 +187,13 @@ double FingerContacts::patch_distance_bound(const WorldShape& s, Vec3 x_local) c
 Vec3 FingerContacts::deepest_patch_point(const WorldShape& s, const Touched& t,
                                          const Local& l) noexcept {
   Vec3 q = l.x;
+  double last_u = 0, last_v = 0;
   for (int it = 0; it < 3; ++it) {
     const Vec3 d = closest_core_local(s.geom, q) - l.x;
     const double pu = std::clamp(dot(d, l.eu), t.ulo, t.uhi),
                  pv = std::clamp(dot(d, l.ev), t.vlo, t.vhi);
+    if (it > 0 && pu == last_u && pv == last_v) break;  // a fixed point: the rounds left repeat it
+    last_u = pu, last_v = pv;
     q = l.x + pu * l.eu + pv * l.ev;
   }
   return q;
@@ -426,7 +429,8 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
   }
 }
 
-void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec3> x) noexcept {
+void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec3> x,
+                                bool gaps) noexcept {
   n_residual_ = 0;
   const double* e = cfg_.table_extent_mm;
   const double held_z = cfg_.table_height_mm + 5.0 * half_thickness_;  // on the table, or on a layer on it
@@ -434,26 +438,33 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
     const Touched& t = touched_[k];
     const Vec3 p = x[t.node];
     const bool held = p.z <= held_z && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3];
-    Geometry geo[kMaxShapesPerNode];
-    bool used[kMaxShapesPerNode] = {};
     // A pair is listed only within kGapMm + its springback; most candidates are further (the
     // candidates reach the step's sweep as well). The lower bound of gather_rt rules those out
     // before the deepest patch point is sought; a pair ruled out is given a depth below every
     // listed pair's threshold on this node, so that it neither is listed nor wins an exit.
-    double springback_max = 0;
-    for (int s = 0; s < t.n_shapes; ++s)
-      springback_max = std::max(springback_max, springback_mm_[t.shape[s]]);
-    const double far_below = -(kGapMm + springback_max);
+    // Without gaps, a node no shape can press is passed over: a pressing contact, or a pinch
+    // of positive depth, needs one shape pressing it.
+    Vec3 xl[kMaxShapesPerNode];
+    double deepest_bound[kMaxShapesPerNode];  // the most the pair's depth can be (mm)
+    double springback_max = 0, may_press = -1e300;
     for (int s = 0; s < t.n_shapes; ++s) {
-      const WorldShape& sh = shapes_[t.shape[s]];
-      const Pose& pose = poses[t.shape[s]];
-      const Vec3 xl = pose.inverse_apply(p);
-      if (half_thickness_ - patch_distance_bound(sh, xl) <= far_below) {
+      springback_max = std::max(springback_max, springback_mm_[t.shape[s]]);
+      xl[s] = poses[t.shape[s]].inverse_apply(p);
+      deepest_bound[s] = half_thickness_ - patch_distance_bound(shapes_[t.shape[s]], xl[s]);
+      may_press = std::max(may_press, deepest_bound[s]);
+    }
+    if (!gaps && may_press <= 0) continue;
+    const double far_below = -(kGapMm + springback_max);
+    Geometry geo[kMaxShapesPerNode];
+    bool used[kMaxShapesPerNode] = {};
+    for (int s = 0; s < t.n_shapes; ++s) {
+      if (deepest_bound[s] <= far_below) {
         geo[s] = Geometry{};
         geo[s].pen = -1e300;
         continue;
       }
-      geo[s] = geometry(sh, pose, t, to_local(pose, t, xl));
+      const Pose& pose = poses[t.shape[s]];
+      geo[s] = geometry(shapes_[t.shape[s]], pose, t, to_local(pose, t, xl[s]));
     }
     for (int s = 0; s < t.n_shapes; ++s)  // one contact per rigid body (see gather_rt)
       for (int o = 0; o < t.n_shapes; ++o) {
@@ -472,7 +483,7 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
       Residual& r = residual_[n_residual_];
       if (held) {
         r = {t.shape[s], geo[s].point, geo[s].n, -1, {}, {}, geo[s].pen, ka};
-        ++n_residual_;
+        if (gaps || r.depth_mm > 0) ++n_residual_;
         continue;
       }
       // Not held: a pinch needs a second shape of the same hand on the other side.
@@ -486,7 +497,7 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
         const double kb = b.stiffness_n_per_mm3 * t.area_mm2;
         r = {t.shape[s], geo[s].point, geo[s].n, t.shape[o], geo[o].point, geo[o].n, geo[s].pen + geo[o].pen,
              ka * kb / (ka + kb)};
-        ++n_residual_;
+        if (gaps || r.depth_mm > 0) ++n_residual_;
         used[s] = used[o] = true;
         break;
       }
@@ -496,7 +507,7 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
 
 void FingerContacts::end_step_rt(std::span<const Vec3> x) noexcept {
   for (int s = 0; s < n_shapes_; ++s) pose_now_[s] = shapes_[s].pose1;
-  measure_rt(pose_now_, x);
+  measure_rt(pose_now_, x, false);
   for (int k = 0; k < n_residual_; ++k) {
     if (residual_[k].depth_mm <= 0) continue;
     ++load_[residual_[k].shape].nodes;

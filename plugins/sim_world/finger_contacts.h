@@ -111,8 +111,11 @@ class FingerContacts final : public sheet::SubstepContacts {
   static constexpr double kHoldAccelMmS2 = 9810.0;
   // The contacts between the nodes touched in the last step (at positions x) and the shapes at
   // POSES (one per shape): residuals(). RT.
-  void measure_rt(std::span<const Pose> poses, std::span<const Vec3> x) noexcept;
-  // After the step: measure_rt at the shapes' pose1, and each shape's count of nodes. RT.
+  // GAPS false: the contacts of positive depth only (what a step's end reports), the same as
+  // those among the full list.
+  void measure_rt(std::span<const Pose> poses, std::span<const Vec3> x, bool gaps = true) noexcept;
+  // After the step: measure_rt at the shapes' pose1 without gaps (residuals() then lists the
+  // contacts of positive depth only), and each shape's count of nodes. RT.
   void end_step_rt(std::span<const Vec3> x) noexcept;
 
   [[nodiscard]] std::span<const Residual> residuals() const noexcept { return {residual_.data(), std::size_t(n_residual_)}; }

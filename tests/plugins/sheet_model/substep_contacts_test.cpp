@@ -109,12 +109,14 @@ TEST_CASE("the sheet's own table contact acts after the substep contacts, on the
   }
 }
 
-TEST_CASE("plasticity_every: the plastic update runs every that many substeps, counted across frames") {
+TEST_CASE(
+    "plasticity_every: each link's plastic update every that many substeps, a third of them after "
+    "each") {
   SheetParams p = small();
   p.solver.substeps = 2;
   p.solver.plasticity_rate = 0.3;
   p.solver.yield_strain = 0.001;
-  p.solver.plastic_bending_only = false;
+  p.solver.plastic_bending_only = false;  // every link is plastic, in link order
   p.solver.plasticity_every = 3;
   p.solver.gravity_mm_per_s2 = {0, 0, 0};
   XpbdSheet s(p);
@@ -122,12 +124,18 @@ TEST_CASE("plasticity_every: the plastic update runs every that many substeps, c
   const Vec3 a = s.positions()[0], b = s.positions()[s.node_count() - 1];
   s.pin(0, a + Vec3{-30, 30, 0});
   s.pin(s.node_count() - 1, b + Vec3{30, -30, 0});
-  auto any_plastic = [&] {
+  // Link k is updated after the substeps whose count, from 0, is k mod 3 (mod 3).
+  auto plastic_in_turn = [&](int turn) {
     const auto e = s.plastic_elongations();
-    return std::any_of(e.begin(), e.end(), [](double d) { return d != 0.0; });
+    bool any = false;
+    for (std::size_t k = static_cast<std::size_t>(turn); k < e.size(); k += 3)
+      any = any || e[k] != 0.0;
+    return any;
   };
-  s.step_rt(0.01);  // substeps 1, 2
-  CHECK_FALSE(any_plastic());
-  s.step_rt(0.01);  // substeps 3, 4: the update after the third
-  CHECK(any_plastic());
+  s.step_rt(0.01);  // substeps 0, 1: the links of turns 0 and 1
+  CHECK(plastic_in_turn(0));
+  CHECK(plastic_in_turn(1));
+  CHECK_FALSE(plastic_in_turn(2));
+  s.step_rt(0.01);  // substeps 2, 3: turn 2 (counted across frames), then turn 0 again
+  CHECK(plastic_in_turn(2));
 }
