@@ -5,12 +5,12 @@
 
 #include <doctest/doctest.h>
 
-#include <kdl/chainfksolverpos_recursive.hpp>
-#include <kdl/chainiksolverpos_lma.hpp>
-
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -247,6 +247,81 @@ inline WorldParams nominal() {
   WorldParams p;
   p.randomise = false;
   return p;
+}
+
+// Both hands driven at once (the fold and crease scenes).
+// One arm and hand driven by a tool pose: arm IK every step (scene.h), hand targets, stiffness.
+struct Arm {
+  ArmIk ik;
+  std::string tool;
+  KDL::Rotation palm;
+  HandQ q{}, k{};
+  ArmQ arm{};
+  Vec3 at;
+  Arm(robot::Side s, std::string t) : ik(robot_model(), s), tool(std::move(t)) {}
+
+  // A first solution from a few guesses over the shoulder, elbow and wrist (non-RT set-up).
+  void solve_first() {
+    for (double s1 : {0.0, 0.5, -0.5, 1.0, -1.0})
+      for (double s2 : {0.5, 0.2, 0.8, -0.3, 1.2})
+        for (double e1 : {1.4, 0.8, 2.0, 2.3})
+          for (double w1 : {1.2, 0.6, -0.6, 1.6}) {
+            const ArmIk::Attempt t = ik.attempt(tool, at, palm, q, {s1, s2, 0.0, e1, 0.0, w1, 0.0});
+            if (t.within_limits && t.reached(0.01)) {
+              arm = t.q;
+              return;
+            }
+          }
+    FAIL("no arm solution for " << tool << " at " << at.x << " " << at.y << " " << at.z);
+  }
+};
+
+struct Bimanual {
+  WorldParams params;
+  Arm r{robot::Side::right, "ffpad"}, l{robot::Side::left, "ffpad"};
+  std::unique_ptr<World> world;
+
+  void start() {
+    r.solve_first();
+    l.solve_first();
+    params.initial_arm_rad[0] = r.arm;
+    params.initial_arm_rad[1] = l.arm;
+    params.initial_hand_rad[0] = r.q;
+    params.initial_hand_rad[1] = l.q;
+    world = std::make_unique<World>(robot_model(), params);
+  }
+  // One step with both tools commanded where they are now (IK from the last solution, within
+  // 0.5 mm: the turned pinch passes near the arm's singular configurations).
+  void step() {
+    for (Arm* a : {&r, &l}) {
+      a->arm = a->ik.solve(a->tool, a->at, a->palm, a->q, a->arm, 0.5);
+      const Side s = a == &r ? Side::right : Side::left;
+      world->command_arm_rt(s, a->arm);
+      world->command_hand_rt(s, a->q, a->k);
+    }
+    world->step_rt();
+  }
+  void hold(double s) {
+    for (int i = 0, n = static_cast<int>(std::lround(s / params.dt_s)); i < n; ++i) step();
+  }
+  [[nodiscard]] const WorldHand& hand(Side s) const {
+    return world->state().hand[static_cast<int>(s)];
+  }
+};
+
+inline Vec3 pad(const WorldHand& h, int tip) {
+  const float* p = h.tip[tip].position_mm;
+  return {p[0], p[1], p[2]};
+}
+
+// B's arm A's tool along a straight line to TO, MM_PER_STEP each 1 ms step.
+inline void move(Bimanual& b, Arm& a, Vec3 to, double mm_per_step) {
+  const Vec3 from = a.at;
+  const int n = std::max(1, static_cast<int>(std::lround(sheet::norm(to - from) / mm_per_step)));
+  for (int i = 1; i <= n; ++i) {
+    a.at = from + (to - from) * (static_cast<double>(i) / n);
+    b.step();
+  }
 }
 
 }  // namespace scene
