@@ -165,6 +165,7 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
             t.vlo = j > 0 ? -0.5 * dv_ : 0.0;
             t.vhi = j < grid_h_ - 1 ? 0.5 * dv_ : 0.0;
             t.area_mm2 = node_area_mm2_[node];
+            t.support = -1;
           }
           Touched& t = touched_[slot];
           if (t.n_shapes >= kMaxShapesPerNode) {
@@ -175,6 +176,45 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
         }
       }
     }
+  }
+  find_supports_rt(x, lo.x, lo.y, cx, cy, nx, ny);
+}
+
+bool FingerContacts::on_table(Vec3 p) const noexcept {
+  const double* e = cfg_.table_extent_mm;
+  return p.z <= cfg_.table_height_mm + 2.0 * half_thickness_ && p.x >= e[0] && p.x <= e[1] &&
+         p.y >= e[2] && p.y <= e[3];
+}
+
+void FingerContacts::find_supports_rt(std::span<const Vec3> x, double lo_x, double lo_y, double cx,
+                                      double cy, int nx, int ny) noexcept {
+  // A touched node a layer up (not itself on the table) rests on the node of another layer
+  // nearest under it in x, y: within 0.75 of the spacing across (the half diagonal of a cell:
+  // one is always found on a layer), one to four thicknesses lower
+  // (or a gap of kInactiveReachMm), at least 3 grid cells away on the sheet, lying on the table.
+  const double across = 0.75 * std::max(du_, dv_), thick = 2.0 * half_thickness_;
+  for (int k = 0; k < n_touched_; ++k) {
+    Touched& t = touched_[k];
+    const Vec3 p = x[t.node];
+    if (on_table(p)) continue;
+    const int ti = t.node % grid_w_, tj = t.node / grid_w_;
+    const int ix = std::clamp(static_cast<int>((p.x - lo_x) / cx), 0, nx - 1);
+    const int iy = std::clamp(static_cast<int>((p.y - lo_y) / cy), 0, ny - 1);
+    double best = across * across;
+    for (int by = std::max(0, iy - 1); by <= std::min(ny - 1, iy + 1); ++by)
+      for (int bx = std::max(0, ix - 1); bx <= std::min(nx - 1, ix + 1); ++bx) {
+        const int c = by * nx + bx;
+        for (int e = cell_start_[c]; e < cell_start_[c + 1]; ++e) {
+          const int b = cell_nodes_[e];
+          const Vec3 q = x[b];
+          const double dz = p.z - q.z, dx = p.x - q.x, dy = p.y - q.y, d2 = dx * dx + dy * dy;
+          if (d2 >= best || dz < 0.5 * thick || dz > 4.0 * thick + kInactiveReachMm || !on_table(q))
+            continue;
+          if (std::abs(b % grid_w_ - ti) + std::abs(b / grid_w_ - tj) < 3) continue;
+          best = d2;
+          t.support = b;
+        }
+      }
   }
 }
 
@@ -231,11 +271,12 @@ void FingerContacts::solve_rt(std::span<Vec3> x, std::span<const Vec3> prev, std
   for (int k = 0; k < n_touched_; ++k) {
     const Touched& t = touched_[k];
     if (!(w[t.node] > 0)) continue;
-    solve_node_rt(t, x, prev, w[t.node], dt_s, weight);
+    solve_node_rt(t, x, prev, w, dt_s, weight);
   }
 }
 
-int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, bool& any) const noexcept {
+int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, bool& any,
+                              std::span<const Vec3> x, std::span<const Vec3> prev) const noexcept {
   int m = 0;
   any = false;
   const double inv_dts2 = 1.0 / (dts * dts);
@@ -273,6 +314,21 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
     any = any || geo.pen > 0;
   }
   if (m == 0) return 0;
+  if (t.support >= 0) {  // a layer on the table under the node: it rests on that instead
+    const Vec3 q = x[t.support];
+    const double pen = q.z + 2.0 * half_thickness_ - p.z;
+    if (pen > -kInactiveReachMm) {
+      Contact& k = c[m++];
+      k = Contact{};
+      k.n = {0, 0, 1};
+      k.pen = pen;
+      k.mu = cfg_.layer_friction;
+      k.surface_move = q - prev[t.support];
+      k.shape = kSupport;
+      any = any || pen > 0;
+    }
+    return m;
+  }
   const double pen_table = half_thickness_ + cfg_.table_height_mm - p.z;
   const double* e = cfg_.table_extent_mm;
   if (pen_table > -kInactiveReachMm && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3]) {
@@ -345,7 +401,7 @@ Vec3 FingerContacts::friction_rt(const Contact* c, int m, double w, double dts, 
   auto tangent = [&](Vec3 v) { return v - dot(v, nm) * nm; };
   const Vec3 a = tangent(u0);
   Vec3 s[kMaxNodeContacts];
-  for (int e = 0; e < m; ++e) s[e] = c[e].shape >= 0 ? tangent(c[e].surface_move) : Vec3{};
+  for (int e = 0; e < m; ++e) s[e] = c[e].shape != kTable ? tangent(c[e].surface_move) : Vec3{};
   Vec3 u = a;
   int stick = -1;
   for (int e = 0; e < m && stick < 0; ++e) {
@@ -391,8 +447,9 @@ Vec3 FingerContacts::friction_rt(const Contact* c, int m, double w, double dts, 
   return u - a;
 }
 
-void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::span<const Vec3> prev, double w,
-                                   double dts, double weight) noexcept {
+void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::span<const Vec3> prev,
+                                   std::span<const double> ws, double dts, double weight) noexcept {
+  const double w = ws[t.node];
   Vec3& p = x[t.node];
   Contact c[kMaxNodeContacts];
   Vec3 fric[kMaxNodeContacts];
@@ -402,7 +459,7 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
   // under the pad's material point, would count the sheet's pull as compression).
   for (int pass = 0; pass < 2; ++pass) {
     bool any = false;
-    const int mm = gather_rt(t, p, dts, c, any);
+    const int mm = gather_rt(t, p, dts, c, any, x, prev);
     if (!any) {
       if (pass == 0) {
         hold_kg_[t.node] = 0.0;
@@ -420,6 +477,8 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
   for (int e = 0; e < m; ++e) hold_mn += c[e].mu * c[e].lambda * inv_dts2;
   hold_kg_[t.node] = hold_mn / kHoldAccelMmS2;
   for (int e = 0; e < m; ++e) {
+    if (c[e].shape == kSupport && c[e].lambda > 0)
+      carry_support_rt(t, c[e], x, prev, ws[t.support], dts);
     if (c[e].shape < 0) continue;
     ShapeLoad& l = load_[c[e].shape];
     const Vec3 f = (-1e-3 * weight) * fric[e];
@@ -427,6 +486,27 @@ void FingerContacts::solve_node_rt(const Touched& t, std::span<Vec3> x, std::spa
     l.friction_moment_nmm += cross(c[e].point, f);
     l.normal_n += (-1e-3 * weight * c[e].lambda * inv_dts2) * c[e].n;
   }
+}
+
+void FingerContacts::carry_support_rt(const Touched& t, const Contact& support, std::span<Vec3> x,
+                                      std::span<const Vec3> prev, double wb, double dts) noexcept {
+  // The node under, loaded by what presses the node above onto it (the same force: lambda over
+  // the substep squared), between the table and the layer above: its own friction problem
+  // (friction_rt) with both, the table still and the layer above moving as it just did. Its
+  // normal needs nothing here: the table holds it (the sheet's contacts push it out).
+  const int b = t.support;
+  if (!(wb > 0)) return;
+  Contact c[2];
+  c[0].n = c[1].n = {0, 0, 1};
+  c[0].mu = cfg_.table_friction_on ? cfg_.table_friction : 0.0;
+  c[0].shape = kTable;
+  c[1].mu = cfg_.layer_friction;
+  c[1].surface_move = x[t.node] - prev[t.node];
+  c[1].shape = kSupport;
+  // lambda is position x mass (kg mm): the node above's correction over its inverse mass.
+  c[0].lambda = c[1].lambda = support.lambda;
+  Vec3 fric[2];
+  x[b] += friction_rt(c, 2, wb, dts, x[b] - prev[b], fric);
 }
 
 void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec3> x,

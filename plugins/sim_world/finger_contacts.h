@@ -27,6 +27,17 @@
 // pressed onto the table by a moving finger needs: it moves with the finger exactly when the
 // finger's friction beats the table's.
 //
+// A layer under the node. A touched node lifted off the table that lies on a node of another
+// layer resting on the table (the nearest under it within half a cell's diagonal, one to four
+// thicknesses lower, at least 3 grid cells away on the sheet; found at the step's start) rests
+// on that node instead of the table: a rigid contact one thickness over it, with paper-paper
+// friction against its motion. What presses the node onto it then loads it too: the node under
+// moves to the minimiser of the same problem between the table (still) and the layer above (as
+// it just moved), each at the full press. So a finger's press holds a stack's layers to each
+// other and to the table; the layers' own contacts (sheet::ContactSolver) bound their friction
+// by the depth each pass corrects, a few mg's worth (a rubber finger slid over a folded sheet's
+// top layer).
+//
 // Reaction. The force each node's contacts exert is the shape's reaction (opposite). The hands'
 // quasi-static balance (hand_compliance.h) reads, before each step, the contacts the step's
 // start leaves with the shapes where the new commands put them (measure_rt: their depth is the
@@ -56,6 +67,7 @@ class FingerContacts final : public sheet::SubstepContacts {
     double table_height_mm = 0;
     double table_extent_mm[4] = {-1e9, 1e9, -1e9, 1e9};  // x_min, x_max, y_min, y_max
     double table_friction = 0.35;  // paper on the table
+    double layer_friction = 0.4;   // paper on paper: a node pressed onto a layer lying on the table
     bool hand_contacts = true;     // false: no shape touches the sheet
     bool finger_friction = true;
     bool table_friction_on = true;
@@ -132,16 +144,19 @@ class FingerContacts final : public sheet::SubstepContacts {
     Vec3 eu, ev, en;                  // the patch's axes (unit: two tangent to the sheet, its normal)
     double ulo = 0, uhi = 0, vlo = 0, vhi = 0;  // its extent along them, mm
     double area_mm2 = 0;
+    std::int32_t support =
+        -1;  // a node of another layer under this one, lying on the table (-1: none)
   };
   struct Contact {  // one of a node's contacts in a substep
     Vec3 n;
     double pen = 0, alpha = 0, mu = 0;  // penetration (mm), compliance / dt_s^2 (1/kg), friction
     Vec3 surface_move;                  // of the contact's surface over the substep
     Vec3 point;
-    int shape = -1;                     // -1: the table
+    int shape = -1;  // kTable, kSupport (the layer under), else the robot's shape
     double lambda = 0;
   };
 
+  static constexpr int kTable = -1, kSupport = -2;
   struct Geometry {  // a node's contact with a shape
     Vec3 n;           // the direction the node is pushed (unit)
     double pen = 0;   // how far along n until it clears the shape by half the thickness (mm)
@@ -161,11 +176,17 @@ class FingerContacts final : public sheet::SubstepContacts {
                                                 const Local& l) noexcept;
   [[nodiscard]] Geometry geometry(const WorldShape& s, const Pose& pose, const Touched& t,
                                   const Local& l) const noexcept;
-  int gather_rt(const Touched& t, Vec3 p, double dt_s, Contact* c, bool& any) const noexcept;
+  int gather_rt(const Touched& t, Vec3 p, double dt_s, Contact* c, bool& any,
+                std::span<const Vec3> x, std::span<const Vec3> prev) const noexcept;
+  [[nodiscard]] bool on_table(Vec3 p) const noexcept;
+  void find_supports_rt(std::span<const Vec3> x, double lo_x, double lo_y, double cx, double cy,
+                        int nx, int ny) noexcept;
+  void carry_support_rt(const Touched& t, const Contact& support, std::span<Vec3> x,
+                        std::span<const Vec3> prev, double w_support, double dt_s) noexcept;
   static Vec3 normal_rt(Contact* c, int m, double w) noexcept;
   static Vec3 friction_rt(const Contact* c, int m, double w, double dt_s, Vec3 u0, Vec3* fric_on_node) noexcept;
-  void solve_node_rt(const Touched& t, std::span<Vec3> x, std::span<const Vec3> prev, double w, double dt_s,
-                     double weight) noexcept;
+  void solve_node_rt(const Touched& t, std::span<Vec3> x, std::span<const Vec3> prev,
+                     std::span<const double> w, double dt_s, double weight) noexcept;
 
   Config cfg_;
   const sheet::SheetModel* sheet_ = nullptr;

@@ -112,6 +112,7 @@ World::World(const robot::RobotModel& model, const WorldParams& params) : params
   cfg.table_height_mm = params_.table_height_mm;
   for (int k = 0; k < 4; ++k) cfg.table_extent_mm[k] = params_.table_extent_mm[k];
   cfg.table_friction = draws_.paper_table;
+  cfg.layer_friction = params_.layer_friction ? draws_.paper_paper : 0.0;
   cfg.hand_contacts = params_.hand_contacts;
   cfg.finger_friction = params_.finger_friction;
   cfg.table_friction_on = params_.table_friction;
