@@ -62,6 +62,7 @@ namespace crease::world {
 class FingerContacts final : public sheet::SubstepContacts {
  public:
   static constexpr int kMaxShapesPerNode = 4;
+  static constexpr int kMaxNodeContacts = kMaxShapesPerNode + 1;  // + the table or the layer under
 
   struct Config {
     double table_height_mm = 0;
@@ -157,6 +158,12 @@ class FingerContacts final : public sheet::SubstepContacts {
   };
 
   static constexpr int kTable = -1, kSupport = -2;
+  static constexpr double kInactiveReachMm =
+      2.0;                               // contacts this far apart still enter a node's block
+  static constexpr double kGapMm = 3.0;  // measure_rt: contacts this far apart still listed
+  // Of two contacts of a node with one rigid body, is the one of penetration a the one to keep?
+  // Both inside: the nearer exit; else the deeper (a penetrating one beats a gap).
+  static bool better_exit(double a, double b) noexcept { return a > 0 && b > 0 ? a < b : a > b; }
   struct Geometry {  // a node's contact with a shape
     Vec3 n;           // the direction the node is pushed (unit)
     double pen = 0;   // how far along n until it clears the shape by half the thickness (mm)
