@@ -208,24 +208,28 @@ void XpbdSheet::project_normal_targets() noexcept {
 void XpbdSheet::update_plasticity(int every) noexcept {
   const double a = params_.solver.plasticity_rate;
   const double eps_y = params_.solver.yield_strain;
-  // One EVERY-th of the links after each substep, interleaved (positions phase, phase + every,
-  // ...): each link every EVERY substeps, and no substep pays for all of them at once (the
-  // world's step had a spike every 10 ms). Contiguous chunks instead moved sim_world_fold's
-  // from-beyond fold by 10 mm (a chaotic scene); interleaved, by 0.1 mm.
+  // One EVERY-th of the links after each substep, interleaved: each link every EVERY substeps,
+  // and no substep pays for all of them at once (the world's step had a spike every 10 ms).
+  // Contiguous chunks instead moved sim_world_fold's from-beyond fold by 10 mm (a chaotic scene);
+  // interleaved, by 0.1-0.3 mm.
   const auto n = static_cast<std::ptrdiff_t>(plastic_links_.size());
   const std::ptrdiff_t phase = plastic_cursor_ % every;
   plastic_cursor_ = (phase + 1) % every;
   bool changed = false;
-  for (std::ptrdiff_t e = phase; e < n; e += every) {
-    const std::int32_t k = plastic_links_[e];
-    const double l = rest_[k];
-    const double dl = norm(x_[topo_.b[k]] - x_[topo_.a[k]]) - l;
-    const double p = plastic_update(dl, plastic_[k], a, eps_y * l);
-    if (p == plastic_[k]) continue;  // within its elastic region: rest length as it was
-    plastic_[k] = p;
-    kernel_.set_rest(k, l + p);
-    changed = true;
-  }
+  // Blocks of kBlock consecutive links dealt out in turn: a substep reads a twentieth of the
+  // links' cache lines (one link in twenty read each line whole, and cost twice the time).
+  constexpr std::ptrdiff_t kBlock = 8;
+  for (std::ptrdiff_t e0 = phase * kBlock; e0 < n; e0 += every * kBlock)
+    for (std::ptrdiff_t e = e0; e < std::min(n, e0 + kBlock); ++e) {
+      const std::int32_t k = plastic_links_[e];
+      const double l = rest_[k];
+      const double dl = norm(x_[topo_.b[k]] - x_[topo_.a[k]]) - l;
+      const double p = plastic_update(dl, plastic_[k], a, eps_y * l);
+      if (p == plastic_[k]) continue;  // within its elastic region: rest length as it was
+      plastic_[k] = p;
+      kernel_.set_rest(k, l + p);
+      changed = true;
+    }
   if (changed) ++plastic_version_;
 }
 

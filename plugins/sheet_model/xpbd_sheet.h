@@ -62,7 +62,8 @@ class XpbdSheet final : public SheetModel {
   void project_targets() noexcept;
   void prepare_normal_targets(double dt_s) noexcept;
   void project_normal_targets() noexcept;
-  void update_plasticity(int every) noexcept;  // the next EVERY-th of plastic_links_, interleaved
+  void update_plasticity(
+      int every) noexcept;  // the next EVERY-th of plastic_links_, in blocks of 8
   void mark_unseen() noexcept;
   void limit_unseen(double dts) noexcept;
   void mark_hidden_held(double within_mm) noexcept;
