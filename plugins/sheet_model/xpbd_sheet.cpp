@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <span>
 
 #include "collision_world.h"
 #include "node_passes.h"
@@ -208,16 +207,15 @@ void XpbdSheet::project_normal_targets() noexcept {
 void XpbdSheet::update_plasticity(int every) noexcept {
   const double a = params_.solver.plasticity_rate;
   const double eps_y = params_.solver.yield_strain;
-  // One EVERY-th of the links after each substep, interleaved: each link every EVERY substeps,
-  // and no substep pays for all of them at once (the world's step had a spike every 10 ms).
-  // Contiguous chunks instead moved sim_world_fold's from-beyond fold by 10 mm (a chaotic scene);
-  // interleaved, by 0.1-0.3 mm.
+  // One EVERY-th of the links after each substep, in blocks of kBlock consecutive links dealt
+  // out in turn: each link every EVERY substeps, and no substep pays for all of them at once
+  // (the world's step had a spike every 10 ms). Contiguous chunks instead moved
+  // sim_world_fold's from-beyond fold by 10 mm (a chaotic scene); dealt out, by 0.1-0.3 mm. One
+  // link in EVERY (no blocks) read every cache line of the links each substep: twice the time.
   const auto n = static_cast<std::ptrdiff_t>(plastic_links_.size());
   const std::ptrdiff_t phase = plastic_cursor_ % every;
   plastic_cursor_ = (phase + 1) % every;
   bool changed = false;
-  // Blocks of kBlock consecutive links dealt out in turn: a substep reads a twentieth of the
-  // links' cache lines (one link in twenty read each line whole, and cost twice the time).
   constexpr std::ptrdiff_t kBlock = 8;
   for (std::ptrdiff_t e0 = phase * kBlock; e0 < n; e0 += every * kBlock)
     for (std::ptrdiff_t e = e0; e < std::min(n, e0 + kBlock); ++e) {
@@ -374,7 +372,6 @@ void XpbdSheet::step_rt(double dt) noexcept {
     hold_hidden();
     update_velocities_rt(x_, v_, prev_, keep_, dts, vcap, simd_);  // with the speed limit
     if (limit_unseen_nodes) limit_unseen(dts);
-    ++substeps_done_;
     if (links_learn_ && !plastic_links_.empty()) update_plasticity(plastic_every);
   }
   (void)infer_creases_rt();  // solver.crease_strain > 0 only; the next frame re-reads the links

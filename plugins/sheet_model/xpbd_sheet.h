@@ -62,8 +62,8 @@ class XpbdSheet final : public SheetModel {
   void project_targets() noexcept;
   void prepare_normal_targets(double dt_s) noexcept;
   void project_normal_targets() noexcept;
-  void update_plasticity(
-      int every) noexcept;  // the next EVERY-th of plastic_links_, in blocks of 8
+  // The next EVERY-th of plastic_links_, in blocks of 8.
+  void update_plasticity(int every) noexcept;
   void mark_unseen() noexcept;
   void limit_unseen(double dts) noexcept;
   void mark_hidden_held(double within_mm) noexcept;
@@ -102,7 +102,6 @@ class XpbdSheet final : public SheetModel {
   int n_unseen_ = 0;
   std::vector<std::int32_t> hidden_held_;  // depth_hold_hidden_mm: the nodes held (this frame)
   int n_hidden_held_ = 0;
-  std::uint64_t substeps_done_ = 0;    // since construction
   std::ptrdiff_t plastic_cursor_ = 0;  // update_plasticity's next turn, 0 .. every - 1
   SubstepContacts* substep_contacts_ = nullptr;
   ContactSolver contacts_;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plugins/sim_world/table_contact.h"
+
 namespace crease::world {
 namespace {
 
@@ -107,13 +109,8 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
           const int node = cell_nodes_[e];
           const Vec3& p = x[node];
           if (p.x < bl[0] || p.x > bh[0] || p.y < bl[1] || p.y > bh[1] || p.z < bl[2] || p.z > bh[2]) continue;
-          // The patch reaches up to half a diagonal of a cell from the node; the node's distance
-          // from the core less the shape's growth bounds its distance from the shape from below
-          // (exactly but for a cylinder, which lies within it).
-          const Vec3 xl = sh.pose1.inverse_apply(p);
-          if (norm(closest_core_local(sh.geom, xl) - xl) - core_grow(sh.geom) >
-              reach_s + sweep + patch_reach_)
-            continue;
+          // A lower bound on the patch's distance from the shape (exact but for a cylinder).
+          if (patch_distance_bound(sh, sh.pose1.inverse_apply(p)) > reach_s + sweep) continue;
           int slot = slot_of_node_[node];
           if (slot < 0) {
             slot = n_touched_++;
@@ -148,9 +145,8 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
 }
 
 bool FingerContacts::on_table(Vec3 p) const noexcept {
-  const double* e = cfg_.table_extent_mm;
-  return p.z <= cfg_.table_height_mm + 2.0 * half_thickness_ && p.x >= e[0] && p.x <= e[1] &&
-         p.y >= e[2] && p.y <= e[3];
+  return p.z <= cfg_.table_height_mm + 2.0 * half_thickness_ &&
+         over_extent(p, cfg_.table_extent_mm);
 }
 
 void FingerContacts::find_supports_rt(std::span<const Vec3> x, double lo_x, double lo_y, double cx,
@@ -228,12 +224,11 @@ FingerContacts::Geometry FingerContacts::geometry(const WorldShape& s, const Pos
 void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec3> x,
                                 bool gaps) noexcept {
   n_residual_ = 0;
-  const double* e = cfg_.table_extent_mm;
   const double held_z = cfg_.table_height_mm + 5.0 * half_thickness_;  // on the table, or on a layer on it
   for (int k = 0; k < n_touched_; ++k) {
     const Touched& t = touched_[k];
     const Vec3 p = x[t.node];
-    const bool held = p.z <= held_z && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3];
+    const bool held = p.z <= held_z && over_extent(p, cfg_.table_extent_mm);
     // A pair is listed only within kGapMm + its springback; most candidates are further (the
     // candidates reach the step's sweep as well). The lower bound of gather_rt rules those out
     // before the deepest patch point is sought; a pair ruled out is given a depth below every

@@ -186,6 +186,9 @@ class FingerContacts final : public sheet::SubstepContacts {
   int gather_rt(const Touched& t, Vec3 p, double dt_s, Contact* c, bool& any,
                 std::span<const Vec3> x, std::span<const Vec3> prev) const noexcept;
   [[nodiscard]] bool on_table(Vec3 p) const noexcept;
+  [[nodiscard]] double table_mu() const noexcept {
+    return cfg_.table_friction_on ? cfg_.table_friction : 0.0;
+  }
   void find_supports_rt(std::span<const Vec3> x, double lo_x, double lo_y, double cx, double cy,
                         int nx, int ny) noexcept;
   void carry_support_rt(const Touched& t, const Contact& support, std::span<Vec3> x,

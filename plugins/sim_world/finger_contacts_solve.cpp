@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "plugins/sim_world/finger_contacts.h"
+#include "plugins/sim_world/table_contact.h"
 
 namespace crease::world {
 namespace {
@@ -116,13 +117,12 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
     return m;
   }
   const double pen_table = half_thickness_ + cfg_.table_height_mm - p.z;
-  const double* e = cfg_.table_extent_mm;
-  if (pen_table > -kInactiveReachMm && p.x >= e[0] && p.x <= e[1] && p.y >= e[2] && p.y <= e[3]) {
+  if (pen_table > -kInactiveReachMm && over_extent(p, cfg_.table_extent_mm)) {
     Contact& k = c[m++];
     k = Contact{};
     k.n = {0, 0, 1};
     k.pen = pen_table;
-    k.mu = cfg_.table_friction_on ? cfg_.table_friction : 0.0;
+    k.mu = table_mu();
     any = any || pen_table > 0;
   }
   return m;
@@ -288,7 +288,7 @@ void FingerContacts::carry_support_rt(const Touched& t, const Contact& support, 
   if (!(wb > 0)) return;
   Contact c[2];
   c[0].n = c[1].n = {0, 0, 1};
-  c[0].mu = cfg_.table_friction_on ? cfg_.table_friction : 0.0;
+  c[0].mu = table_mu();
   c[0].shape = kTable;
   c[1].mu = cfg_.layer_friction;
   c[1].surface_move = x[t.node] - prev[t.node];
