@@ -183,14 +183,19 @@ class FingerContacts final : public sheet::SubstepContacts {
                                                 const Local& l) noexcept;
   [[nodiscard]] Geometry geometry(const WorldShape& s, const Pose& pose, const Touched& t,
                                   const Local& l) const noexcept;
+  // Two shapes that can pinch a node: two fingers of one hand, or a finger and the palm (a node
+  // in the crook of one finger is left to the substeps: its joints do not feel it).
+  [[nodiscard]] static bool pinch_pair(const WorldShape& a, const WorldShape& b) noexcept {
+    return a.side == b.side && (a.finger != b.finger || a.finger < 0);
+  }
+  [[nodiscard]] bool may_pinch(const Touched& t) const noexcept;
   int gather_rt(const Touched& t, Vec3 p, double dt_s, Contact* c, bool& any,
                 std::span<const Vec3> x, std::span<const Vec3> prev) const noexcept;
   [[nodiscard]] bool on_table(Vec3 p) const noexcept;
   [[nodiscard]] double table_mu() const noexcept {
     return cfg_.table_friction_on ? cfg_.table_friction : 0.0;
   }
-  void find_supports_rt(std::span<const Vec3> x, double lo_x, double lo_y, double cx, double cy,
-                        int nx, int ny) noexcept;
+  void find_supports_rt(std::span<const Vec3> x, int nx, int ny) noexcept;
   void carry_support_rt(const Touched& t, const Contact& support, std::span<Vec3> x,
                         std::span<const Vec3> prev, double w_support, double dt_s) noexcept;
   static Vec3 normal_rt(Contact* c, int m, double w) noexcept;
@@ -221,6 +226,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   // Node buckets over the sheet's box in x, y (counting sort, rebuilt every step).
   static constexpr int kMaxCells = 64;
   std::vector<std::int32_t> cell_start_, cell_nodes_;
+  std::vector<std::int32_t> cell_of_;  // per node: its bucket this step
 };
 
 }  // namespace crease::world

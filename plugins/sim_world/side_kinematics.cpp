@@ -74,6 +74,9 @@ SideKinematics::SideKinematics(const robot::RobotModel& model, robot::Side side)
   pose_.assign(seg_.size(), Pose{});
   axis_.assign(seg_.size(), Vec3{});
   origin_.assign(seg_.size(), Vec3{});
+  last_q_.assign(seg_.size(), 0.0);
+  moved_.assign(seg_.size(), 1);
+  posed_ = false;
 }
 
 void SideKinematics::update_rt(robot::ArmAngles arm, robot::HandAngles hand) noexcept {
@@ -84,6 +87,10 @@ void SideKinematics::update_rt(robot::ArmAngles arm, robot::HandAngles hand) noe
     double q = 0.0;
     if (s.source.kind == Source::arm) q = s.source.multiplier * arm[s.source.index] + s.source.offset;
     if (s.source.kind == Source::hand) q = s.source.multiplier * hand[s.source.index] + s.source.offset;
+    const bool moved = !posed_ || q != last_q_[i] || (s.parent >= 0 && moved_[s.parent]);
+    moved_[i] = moved ? 1 : 0;
+    if (!moved) continue;
+    last_q_[i] = q;
     frame_[i] = base * s.segment.pose(q);
     pose_[i] = to_pose(frame_[i]);
     if (s.source.kind != Source::none) {
@@ -92,6 +99,7 @@ void SideKinematics::update_rt(robot::ArmAngles arm, robot::HandAngles hand) noe
       origin_[i] = mm(base * j.JointOrigin());
     }
   }
+  posed_ = true;
 }
 
 int SideKinematics::link_index(std::string_view name) const noexcept {

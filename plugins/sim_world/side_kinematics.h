@@ -9,10 +9,10 @@
 // KDL and the URDF are in metres). RT: update_rt and the queries allocate nothing.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <kdl/frames.hpp>
 #include <kdl/segment.hpp>
-
-#include <array>
 #include <span>
 #include <string>
 #include <string_view>
@@ -81,6 +81,11 @@ class SideKinematics {
   std::vector<KDL::Frame> frame_;  // world <- segment tip, metres
   std::vector<Pose> pose_;         // the same, mm
   std::vector<Vec3> axis_, origin_;  // movable segments: joint axis (unit) and a point on it, world mm
+  // update_rt recomputes a segment only if its joint value or a segment above it changed since
+  // the last call (a step poses the arm three times with the same arm angles).
+  std::vector<double> last_q_;
+  std::vector<std::uint8_t> moved_;
+  bool posed_ = false;
 };
 
 }  // namespace crease::world

@@ -55,6 +55,35 @@ TEST_CASE("every tool frame where robot_model's KDL chain puts it, on both sides
   }
 }
 
+TEST_CASE("update_rt recomputes what moved: many calls, one joint at a time, equal a fresh pose") {
+  // A step poses a side three times, the arm unchanged; only the segments under a changed joint
+  // are recomputed. Over a run of calls, each changing one arm or hand joint (or none), every
+  // link pose and joint axis equals that of a kinematics posed once at the same angles.
+  const auto& m = robot_model();
+  SideKinematics k(m, robot::Side::left);
+  ArmQ arm;
+  HandQ hand;
+  config(m, robot::Side::left, 7, arm, hand);
+  SplitMix64 rng(77);
+  for (int call = 0; call < 60; ++call) {
+    const int which = call % 3 == 2
+                          ? -1
+                          : static_cast<int>(rng.next() % (robot::kArmJoints + robot::kHandJoints));
+    if (which >= 0 && which < robot::kArmJoints) arm[which] += 0.05 * rng.symmetric();
+    if (which >= robot::kArmJoints) hand[which - robot::kArmJoints] += 0.05 * rng.symmetric();
+    k.update_rt(arm, hand);
+    SideKinematics fresh(m, robot::Side::left);
+    fresh.update_rt(arm, hand);
+    for (int link = 0; link < fresh.link_count(); ++link) {
+      const Pose &a = k.link_pose(link), &b = fresh.link_pose(link);
+      REQUIRE(a.t.x == b.t.x);
+      REQUIRE(a.t.y == b.t.y);
+      REQUIRE(a.t.z == b.t.z);
+      for (int e = 0; e < 9; ++e) REQUIRE(a.r[e] == b.r[e]);
+    }
+  }
+}
+
 TEST_CASE("the hand Jacobian: finite differences, its transpose, and the wrench form") {
   const auto& m = robot_model();
   SideKinematics k(m, robot::Side::right);
