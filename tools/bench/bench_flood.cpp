@@ -1,9 +1,11 @@
-// crease-bench flood [--seconds N] [--turn S] [--rate R] [--clients C]: the 1 kHz loop's wake-up
-// latency with and without a flood of control requests (default 10,000 per second from 4
+// crease-bench flood [--seconds N] [--turn S] [--rate R] [--clients C] [--aa]: the 1 kHz loop's
+// wake-up latency with and without a flood of control requests (default 10,000 per second from 4
 // clients), measured on the same daemon in interleaved turns of S seconds (default 2): quiet,
 // flood, quiet, flood, ... for N seconds of each side (default 20 s each, 40 s in all), so a
 // neighbour's load that comes and goes falls on both sides alike. p99 of 20,000 cycles a side
 // moves by a few per cent between runs on a quiet machine.
+// --aa: the same turns with no requests on either side (the clients stay idle): the ratio the
+// machine's own noise gives, against which a flood's ratio can be read.
 #include <unistd.h>
 
 #include <atomic>
@@ -60,6 +62,7 @@ int run(int argc, char** argv) {
   const double rate = crease::bench::arg_double(argc, argv, "--rate", 10000);
   const int clients = static_cast<int>(crease::bench::arg_double(argc, argv, "--clients", 4));
   const int priority = static_cast<int>(crease::bench::arg_double(argc, argv, "--priority", 80));
+  const bool aa = crease::bench::has_flag(argc, argv, "--aa");
 
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("crease-flood-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -92,6 +95,7 @@ int run(int argc, char** argv) {
   std::vector<std::thread> threads;
   for (int c = 0; c < clients; ++c) {
     threads.emplace_back([&, c] {
+      if (aa) return;  // no client at all
       crease::control::ControlClient client(sock);
       const auto period = std::chrono::duration<double>(double(clients) / rate);
       const nlohmann::json reqs[] = {{{"cmd", "status"}},
@@ -123,8 +127,15 @@ int run(int argc, char** argv) {
   }
 
   const int turns = std::max(1, static_cast<int>(std::lround(seconds / turn_s)));
-  std::printf("flood: %d turns of %.1f s a side (quiet, then %.0f requests/s from %d clients), %.0f s in all\n", turns,
-              turn_s, rate, clients, 2 * turns * turn_s);
+  if (aa)
+    std::printf(
+        "flood: %d turns of %.1f s a side, A/A: no requests on either side, %.0f s in all\n", turns,
+        turn_s, 2 * turns * turn_s);
+  else
+    std::printf(
+        "flood: %d turns of %.1f s a side (quiet, then %.0f requests/s from %d clients), %.0f s in "
+        "all\n",
+        turns, turn_s, rate, clients, 2 * turns * turn_s);
   Snapshot quiet, flood;
   double flood_s = 0;
   for (int t = 0; t < 2 * turns; ++t) {
@@ -149,8 +160,8 @@ int run(int argc, char** argv) {
                 s.percentile(99.9) / 1e3, double(s.max_ns) / 1e3, (unsigned long long)s.count);
   };
   std::printf("\n  wake-up latency (us)         %9s %9s %9s %9s %9s\n", "p50", "p99", "p99.9", "max", "cycles");
-  row("no requests", quiet);
-  row("with the flood", flood);
+  row(aa ? "first turns (no requests)" : "no requests", quiet);
+  row(aa ? "second turns (no requests)" : "with the flood", flood);
   const double p99_ratio = double(flood.percentile(99)) / std::max<double>(1000.0, double(quiet.percentile(99)));
   const double p999_ratio = double(flood.percentile(99.9)) / std::max<double>(1000.0, double(quiet.percentile(99.9)));
   std::printf("  requests: %llu in %.1f s of flood (%.0f/s), busy: %llu, failed: %llu\n", (unsigned long long)sent.load(),
