@@ -36,6 +36,9 @@ void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const W
   touched_.resize(n);
   shape_near_.assign(shape_count, 0);
   springback_mm_.assign(shape_count, 0.0);
+  bound_reach_mm_.resize(shape_count);
+  for (int k = 0; k < shape_count; ++k)
+    bound_reach_mm_[k] = core_grow(shapes[k].geom) + patch_reach_;
   pose_now_.resize(shape_count);
   pose_before_.resize(shape_count);
   load_.assign(shape_count, ShapeLoad{});
@@ -43,6 +46,7 @@ void FingerContacts::configure(const sheet::SheetModel& sheet, std::span<const W
   cell_start_.assign(kMaxCells * kMaxCells + 1, 0);
   cell_nodes_.assign(n, 0);
   cell_of_.assign(n, 0);
+  cell_points_.assign(n, Vec3{});
   n_shapes_ = shape_count;
 }
 
@@ -86,7 +90,11 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
     ++cell_start_[cell_of_[i] + 1];
   }
   for (int c = 0; c < nx * ny; ++c) cell_start_[c + 1] += cell_start_[c];
-  for (int i = 0; i < n; ++i) cell_nodes_[cell_start_[cell_of_[i]]++] = i;
+  for (int i = 0; i < n; ++i) {
+    const int e = cell_start_[cell_of_[i]]++;
+    cell_nodes_[e] = i;
+    cell_points_[e] = x[i];
+  }
   for (int c = nx * ny; c > 0; --c) cell_start_[c] = cell_start_[c - 1];
   cell_start_[0] = 0;
 
@@ -111,42 +119,43 @@ void FingerContacts::begin_step_rt(std::span<const Vec3> x, std::span<const Vec3
     const double sweep = norm(sh.pose1.t - sh.pose0.t) + turn * radius;
     max_push_mm_ = std::max(max_push_mm_, sweep);
     const int ix0 = cell_x(bl[0]), ix1 = cell_x(bh[0]), iy0 = cell_y(bl[1]), iy1 = cell_y(bh[1]);
+    // A row's buckets ix0..ix1 lie contiguous in bucket order.
     for (int iy = iy0; iy <= iy1; ++iy) {
-      for (int ix = ix0; ix <= ix1; ++ix) {
-        const int c = iy * nx + ix;
-        for (int e = cell_start_[c]; e < cell_start_[c + 1]; ++e) {
-          const int node = cell_nodes_[e];
-          const Vec3& p = x[node];
-          if (p.x < bl[0] || p.x > bh[0] || p.y < bl[1] || p.y > bh[1] || p.z < bl[2] || p.z > bh[2]) continue;
-          // A lower bound on the patch's distance from the shape (exact but for a cylinder).
-          if (patch_distance_bound(sh, sh.pose1.inverse_apply(p)) > reach_s + sweep) continue;
-          int slot = slot_of_node_[node];
-          if (slot < 0) {
-            slot = n_touched_++;
-            slot_of_node_[node] = slot;
-            Touched& t = touched_[slot];
-            t.node = node;
-            t.n_shapes = 0;
-            const int i = node % grid_w_, j = node / grid_w_;
-            const Vec3 du = x[j * grid_w_ + std::min(i + 1, grid_w_ - 1)] - x[j * grid_w_ + std::max(i - 1, 0)];
-            const Vec3 dv = x[std::min(j + 1, grid_h_ - 1) * grid_w_ + i] - x[std::max(j - 1, 0) * grid_w_ + i];
-            t.eu = normalized(du);
-            t.ev = normalized(dv - dot(dv, t.eu) * t.eu);
-            t.en = cross(t.eu, t.ev);
-            t.ulo = i > 0 ? -0.5 * du_ : 0.0;
-            t.uhi = i < grid_w_ - 1 ? 0.5 * du_ : 0.0;
-            t.vlo = j > 0 ? -0.5 * dv_ : 0.0;
-            t.vhi = j < grid_h_ - 1 ? 0.5 * dv_ : 0.0;
-            t.area_mm2 = node_area_mm2_[node];
-            t.support = -1;
-          }
+      for (int e = cell_start_[iy * nx + ix0]; e < cell_start_[iy * nx + ix1 + 1]; ++e) {
+        const Vec3& p = cell_points_[e];
+        if (p.x < bl[0] || p.x > bh[0] || p.y < bl[1] || p.y > bh[1] || p.z < bl[2] || p.z > bh[2])
+          continue;
+        // A lower bound on the patch's distance from the shape (exact but for a cylinder).
+        if (patch_distance_bound(s, sh.pose1.inverse_apply(p)) > reach_s + sweep) continue;
+        const int node = cell_nodes_[e];
+        int slot = slot_of_node_[node];
+        if (slot < 0) {
+          slot = n_touched_++;
+          slot_of_node_[node] = slot;
           Touched& t = touched_[slot];
-          if (t.n_shapes >= kMaxShapesPerNode) {
-            ++dropped_;
-            continue;
-          }
-          t.shape[t.n_shapes++] = s;
+          t.node = node;
+          t.n_shapes = 0;
+          const int i = node % grid_w_, j = node / grid_w_;
+          const Vec3 du =
+              x[j * grid_w_ + std::min(i + 1, grid_w_ - 1)] - x[j * grid_w_ + std::max(i - 1, 0)];
+          const Vec3 dv =
+              x[std::min(j + 1, grid_h_ - 1) * grid_w_ + i] - x[std::max(j - 1, 0) * grid_w_ + i];
+          t.eu = normalized(du);
+          t.ev = normalized(dv - dot(dv, t.eu) * t.eu);
+          t.en = cross(t.eu, t.ev);
+          t.ulo = i > 0 ? -0.5 * du_ : 0.0;
+          t.uhi = i < grid_w_ - 1 ? 0.5 * du_ : 0.0;
+          t.vlo = j > 0 ? -0.5 * dv_ : 0.0;
+          t.vhi = j < grid_h_ - 1 ? 0.5 * dv_ : 0.0;
+          t.area_mm2 = node_area_mm2_[node];
+          t.support = -1;
         }
+        Touched& t = touched_[slot];
+        if (t.n_shapes >= kMaxShapesPerNode) {
+          ++dropped_;
+          continue;
+        }
+        t.shape[t.n_shapes++] = s;
       }
     }
   }
@@ -190,8 +199,8 @@ void FingerContacts::find_supports_rt(std::span<const Vec3> x, int nx, int ny) n
 
 double FingerContacts::max_push_mm(double) const noexcept { return n_touched_ > 0 ? max_push_mm_ : 0.0; }
 
-double FingerContacts::patch_distance_bound(const WorldShape& s, Vec3 x_local) const noexcept {
-  return norm(closest_core_local(s.geom, x_local) - x_local) - core_grow(s.geom) - patch_reach_;
+double FingerContacts::patch_distance_bound(int shape, Vec3 x_local) const noexcept {
+  return norm(closest_core_local(shapes_[shape].geom, x_local) - x_local) - bound_reach_mm_[shape];
 }
 
 Vec3 FingerContacts::deepest_patch_point(const WorldShape& s, const Touched& t,
@@ -252,7 +261,7 @@ void FingerContacts::measure_rt(std::span<const Pose> poses, std::span<const Vec
     for (int s = 0; s < t.n_shapes; ++s) {
       springback_max = std::max(springback_max, springback_mm_[t.shape[s]]);
       xl[s] = poses[t.shape[s]].inverse_apply(p);
-      deepest_bound[s] = half_thickness_ - patch_distance_bound(shapes_[t.shape[s]], xl[s]);
+      deepest_bound[s] = half_thickness_ - patch_distance_bound(t.shape[s], xl[s]);
       may_press = std::max(may_press, deepest_bound[s]);
     }
     if (!gaps && may_press <= 0) continue;

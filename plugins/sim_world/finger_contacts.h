@@ -178,7 +178,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   }
   // A lower bound on the distance of the node's patch from the shape (mm): the node's from the
   // core, less the shape's growth and the patch's reach.
-  [[nodiscard]] double patch_distance_bound(const WorldShape& s, Vec3 x_local) const noexcept;
+  [[nodiscard]] double patch_distance_bound(int shape, Vec3 x_local) const noexcept;
   [[nodiscard]] static Vec3 deepest_patch_point(const WorldShape& s, const Touched& t,
                                                 const Local& l) noexcept;
   [[nodiscard]] Geometry geometry(const WorldShape& s, const Pose& pose, const Touched& t,
@@ -217,6 +217,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   int n_touched_ = 0;
   std::vector<std::uint8_t> shape_near_;    // this step: may touch the sheet
   std::vector<double> springback_mm_;       // per shape: set_springback
+  std::vector<double> bound_reach_mm_;      // per shape: its core's growth plus patch_reach_
   std::vector<Pose> pose_now_, pose_before_;  // per shape, at the current substep's end and start
   std::vector<ShapeLoad> load_;
   std::vector<Residual> residual_;
@@ -227,6 +228,7 @@ class FingerContacts final : public sheet::SubstepContacts {
   static constexpr int kMaxCells = 64;
   std::vector<std::int32_t> cell_start_, cell_nodes_;
   std::vector<std::int32_t> cell_of_;  // per node: its bucket this step
+  std::vector<Vec3> cell_points_;      // the nodes' positions in bucket order (as cell_nodes_)
 };
 
 }  // namespace crease::world

@@ -76,7 +76,7 @@ int FingerContacts::gather_rt(const Touched& t, Vec3 p, double dts, Contact* c, 
     // core, less the shape's growth and the patch's reach) rules most of those out before the
     // patch's deepest point is sought (three core projections and a surface query).
     const Vec3 xl = pose.inverse_apply(p);
-    if (patch_distance_bound(s, xl) >= half_thickness_ + kInactiveReachMm) continue;
+    if (patch_distance_bound(si, xl) >= half_thickness_ + kInactiveReachMm) continue;
     const Geometry geo = geometry(s, pose, t, to_local(pose, t, xl));
     if (geo.pen <= -kInactiveReachMm) continue;
     // Shapes of one rigid body (a fingertip's cover, pad and back) overlap: a node inside two

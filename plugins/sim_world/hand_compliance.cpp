@@ -46,6 +46,7 @@ void HandCompliance::configure(const Limits& limits, int max_contacts) {
   n_nz_.assign(g_.size(), 0);
   on_.assign(g_.size(), 0);
   g_old_.assign(g_.size(), 0.0);
+  depth_now_.assign(g_.size(), 0.0);
   truncated_ = 0;
 }
 
@@ -119,6 +120,7 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   for (int j = 0; j < kN; ++j) cur[j] = std::clamp(old[j], lo[j], hi[j]);
   double e_cur = energy(cur);
   std::uint8_t* on = on_.data();
+  double* depth_now = depth_now_.data();  // per contact: its depth at cur, this round
   bool locked[kN] = {};
   rounds_ = 0;
   failed_ = false;
@@ -128,7 +130,10 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
   // potential falls, so the active sets cannot cycle.
   for (int round = 0; round < kMaxRounds; ++round) {
     ++rounds_;
-    for (int c = 0; c < nc; ++c) on[c] = depth(c, cur) > 0;
+    for (int c = 0; c < nc; ++c) {
+      depth_now[c] = depth(c, cur);
+      on[c] = depth_now[c] > 0;
+    }
     double grad[kN];
     for (int j = 0; j < kN; ++j) {
       k_eff[j] = std::fabs(k_full[j] * cur[j]) <= tmax[j] ? k_full[j] : tmax[j] / std::fabs(cur[j]);
@@ -136,7 +141,7 @@ void HandCompliance::solve_rt(const SideKinematics& kin, std::span<const Contact
     }
     for (int c = 0; c < nc; ++c) {
       if (!on[c]) continue;
-      const double f = contacts[c].stiffness_n_per_mm * depth(c, cur);
+      const double f = contacts[c].stiffness_n_per_mm * depth_now[c];
       for (int k = 0; k < n_nz_[c]; ++k) grad[nz_[c][k]] += f * g_[c][nz_[c][k]];
     }
     // A joint at a bound stays there while the potential falls beyond it.

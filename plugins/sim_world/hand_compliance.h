@@ -88,6 +88,7 @@ class HandCompliance {
   std::vector<std::uint8_t> n_nz_;
   std::vector<std::uint8_t> on_;  // per contact: pushing in the current round
   std::vector<double> g_old_;     // per contact: g . dq_old (mm), fixed for a solve
+  std::vector<double> depth_now_;  // per contact: its depth at the round's point (mm)
   std::uint64_t truncated_ = 0;
   double max_step_rad_ = 1e300;
   int saturated_ = 0, at_limit_ = 0, rounds_ = 0;

@@ -14,8 +14,9 @@
 // cannot keep a crease: its fold is held by gravity and friction alone.
 //
 //   crease-bench world [--quick] [--ours-only] [--mj-solver CG|PGS|Newton] [--mj-iterations N]
-//   [--cpu K]
+//   [--cpu K] [--scene press_drag|pinch|fold]
 // --quick: press_drag's first 1.7 simulated seconds (descent and press) only.
+// --scene: that scene alone, ours alone (implies --ours-only: to profile one scene).
 // --ours-only: MuJoCo not run (to profile ours); ours' end states are printed, the last line
 // carries ours alone.
 // Last line: world: ours_rtf=... mujoco_rtf=... ratio=... drag_mm=ours/mujoco pinch_rise_mm=...
@@ -212,10 +213,13 @@ std::vector<std::string> figure_names(const Script& sc) {
 
 int run_world(int argc, char** argv) {
   const bool quick = bench::has_flag(argc, argv, "--quick");
-  const bool ours_only = bench::has_flag(argc, argv, "--ours-only");
+  std::string only;  // --scene
   MujocoOptions mo;
-  for (int i = 1; i + 1 < argc; ++i)
+  for (int i = 1; i + 1 < argc; ++i) {
     if (std::strcmp(argv[i], "--mj-solver") == 0) mo.solver = argv[i + 1];
+    if (std::strcmp(argv[i], "--scene") == 0) only = argv[i + 1];
+  }
+  const bool ours_only = bench::has_flag(argc, argv, "--ours-only") || !only.empty();
   mo.iterations = static_cast<int>(bench::arg_double(argc, argv, "--mj-iterations", mo.iterations));
   pin_to_cpu(static_cast<int>(bench::arg_double(argc, argv, "--cpu", 1)));
 
@@ -233,6 +237,7 @@ int run_world(int argc, char** argv) {
   double ours_wall = 0, theirs_wall = 0, simulated = 0;
   std::vector<std::vector<double>> ours_f, theirs_f;
   for (const Script& sc : scenes) {
+    if (!only.empty() && sc.name != only) continue;
     std::printf("scene %s: %.2f simulated s\n", sc.name.c_str(), static_cast<double>(sc.arm.size()) * sc.params.dt_s);
     std::vector<MirroredShape> mirror;
     double table_mu = 0;
@@ -262,6 +267,10 @@ int run_world(int argc, char** argv) {
       std::printf("  %-52s %9.2f %9.2f\n", names[i].c_str(), ours_f.back()[i], theirs_f.back()[i]);
   }
   if (ours_only) {
+    if (simulated <= 0) {
+      std::fprintf(stderr, "crease-bench world: no scene named '%s'\n", only.c_str());
+      return 1;
+    }
     std::printf("world: ours_rtf=%.2f mujoco_rtf=n/a (--ours-only)\n", simulated / ours_wall);
     return 0;
   }
