@@ -14,9 +14,13 @@
 // cannot keep a crease: its fold is held by gravity and friction alone.
 //
 //   crease-bench world [--quick] [--ours-only] [--mj-solver CG|PGS|Newton] [--mj-iterations N]
-//   [--cpu K] [--scene press_drag|pinch|fold]
+//   [--cpu K] [--scene press_drag|pinch|fold] [--ensemble N]
 // --quick: press_drag's first 1.7 simulated seconds (descent and press) only.
 // --scene: that scene alone, ours alone (implies --ours-only: to profile one scene).
+// --ensemble N (with --ours-only): each scene N times, the sheet laid 0.5 mm off its place in
+// N - 1 directions (and once in place); per end-state figure the median and the range. The
+// scenes are open-loop and chaotic where a pinch holds the sheet by a few nodes: a change to the
+// world's physics is judged by the spread it leaves, not by one run.
 // --ours-only: MuJoCo not run (to profile ours); ours' end states are printed, the last line
 // carries ours alone.
 // Last line: world: ours_rtf=... mujoco_rtf=... ratio=... drag_mm=ours/mujoco pinch_rise_mm=...
@@ -29,6 +33,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -220,6 +225,8 @@ int run_world(int argc, char** argv) {
     if (std::strcmp(argv[i], "--scene") == 0) only = argv[i + 1];
   }
   const bool ours_only = bench::has_flag(argc, argv, "--ours-only") || !only.empty();
+  const int ensemble =
+      std::max(1, static_cast<int>(bench::arg_double(argc, argv, "--ensemble", 1)));
   mo.iterations = static_cast<int>(bench::arg_double(argc, argv, "--mj-iterations", mo.iterations));
   pin_to_cpu(static_cast<int>(bench::arg_double(argc, argv, "--cpu", 1)));
 
@@ -245,10 +252,30 @@ int run_world(int argc, char** argv) {
     if (ours_only) {  // ours' end state alone
       ours_wall += ours.wall_s;
       simulated += ours.simulated_s;
-      const std::vector<double> f = scene_figures(sc, ours, mirror);
+      std::vector<std::vector<double>> runs{scene_figures(sc, ours, mirror)};
+      for (int k = 1; k < ensemble; ++k) {  // the sheet laid 0.5 mm off, direction k of N - 1
+        Script moved = sc;
+        const double a = 2.0 * std::numbers::pi * (k - 1) / (ensemble - 1);
+        moved.params.sheet.grid.origin_mm.x += 0.5 * std::cos(a);
+        moved.params.sheet.grid.origin_mm.y += 0.5 * std::sin(a);
+        std::vector<MirroredShape> m;
+        const SheetRun r = run_ours(model, moved, m, table_mu);
+        ours_wall += r.wall_s;
+        simulated += r.simulated_s;
+        runs.push_back(scene_figures(moved, r, m));
+      }
       const std::vector<std::string> names = figure_names(sc);
-      for (std::size_t i = 0; i < names.size(); ++i)
-        std::printf("  %-52s %9.2f\n", names[i].c_str(), f[i]);
+      if (ensemble > 1) std::printf("  %-52s %9s %9s %9s\n", "end state", "median", "min", "max");
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        std::vector<double> v;
+        for (const auto& f : runs) v.push_back(f[i]);
+        std::sort(v.begin(), v.end());
+        if (ensemble > 1)
+          std::printf("  %-52s %9.2f %9.2f %9.2f\n", names[i].c_str(), v[v.size() / 2], v.front(),
+                      v.back());
+        else
+          std::printf("  %-52s %9.2f\n", names[i].c_str(), v[0]);
+      }
       continue;
     }
     SheetRun theirs;
