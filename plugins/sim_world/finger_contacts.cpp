@@ -180,19 +180,17 @@ void FingerContacts::find_supports_rt(std::span<const Vec3> x, int nx, int ny) n
     const int ti = t.node % grid_w_, tj = t.node / grid_w_;
     const int ix = cell_of_[t.node] % nx, iy = cell_of_[t.node] / nx;
     double best = across * across;
+    const int bx0 = std::max(0, ix - 1), bx1 = std::min(nx - 1, ix + 1);
     for (int by = std::max(0, iy - 1); by <= std::min(ny - 1, iy + 1); ++by)
-      for (int bx = std::max(0, ix - 1); bx <= std::min(nx - 1, ix + 1); ++bx) {
-        const int c = by * nx + bx;
-        for (int e = cell_start_[c]; e < cell_start_[c + 1]; ++e) {
-          const int b = cell_nodes_[e];
-          const Vec3 q = x[b];
-          const double dz = p.z - q.z, dx = p.x - q.x, dy = p.y - q.y, d2 = dx * dx + dy * dy;
-          if (d2 >= best || dz < 0.5 * thick || dz > 4.0 * thick + kInactiveReachMm || !on_table(q))
-            continue;
-          if (std::abs(b % grid_w_ - ti) + std::abs(b / grid_w_ - tj) < 3) continue;
-          best = d2;
-          t.support = b;
-        }
+      for (int e = cell_start_[by * nx + bx0]; e < cell_start_[by * nx + bx1 + 1]; ++e) {
+        const Vec3& q = cell_points_[e];
+        const double dz = p.z - q.z, dx = p.x - q.x, dy = p.y - q.y, d2 = dx * dx + dy * dy;
+        if (d2 >= best || dz < 0.5 * thick || dz > 4.0 * thick + kInactiveReachMm || !on_table(q))
+          continue;
+        const int b = cell_nodes_[e];
+        if (std::abs(b % grid_w_ - ti) + std::abs(b / grid_w_ - tj) < 3) continue;
+        best = d2;
+        t.support = b;
       }
   }
 }

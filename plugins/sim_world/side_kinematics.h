@@ -9,10 +9,11 @@
 // KDL and the URDF are in metres). RT: update_rt and the queries allocate nothing.
 #pragma once
 
-#include <array>
-#include <cstdint>
 #include <kdl/frames.hpp>
 #include <kdl/segment.hpp>
+
+#include <array>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>

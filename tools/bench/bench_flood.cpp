@@ -4,7 +4,7 @@
 // flood, quiet, flood, ... for N seconds of each side (default 20 s each, 40 s in all), so a
 // neighbour's load that comes and goes falls on both sides alike. p99 of 20,000 cycles a side
 // moves by a few per cent between runs on a quiet machine.
-// --aa: the same turns with no requests on either side (the clients stay idle): the ratio the
+// --aa: the same turns with no requests on either side (no client connects): the ratio the
 // machine's own noise gives, against which a flood's ratio can be read.
 #include <unistd.h>
 

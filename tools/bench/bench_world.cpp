@@ -17,7 +17,7 @@
 //   [--cpu K] [--scene press_drag|pinch|fold] [--ensemble N]
 // --quick: press_drag's first 1.7 simulated seconds (descent and press) only.
 // --scene: that scene alone, ours alone (implies --ours-only: to profile one scene).
-// --ensemble N (with --ours-only): each scene N times, the sheet laid 0.5 mm off its place in
+// --ensemble N (implies --ours-only): each scene N times, the sheet laid 0.5 mm off its place in
 // N - 1 directions (and once in place); per end-state figure the median and the range. The
 // scenes are open-loop and chaotic where a pinch holds the sheet by a few nodes: a change to the
 // world's physics is judged by the spread it leaves, not by one run.
@@ -224,9 +224,9 @@ int run_world(int argc, char** argv) {
     if (std::strcmp(argv[i], "--mj-solver") == 0) mo.solver = argv[i + 1];
     if (std::strcmp(argv[i], "--scene") == 0) only = argv[i + 1];
   }
-  const bool ours_only = bench::has_flag(argc, argv, "--ours-only") || !only.empty();
   const int ensemble =
       std::max(1, static_cast<int>(bench::arg_double(argc, argv, "--ensemble", 1)));
+  const bool ours_only = bench::has_flag(argc, argv, "--ours-only") || !only.empty() || ensemble > 1;
   mo.iterations = static_cast<int>(bench::arg_double(argc, argv, "--mj-iterations", mo.iterations));
   pin_to_cpu(static_cast<int>(bench::arg_double(argc, argv, "--cpu", 1)));
 

@@ -80,6 +80,11 @@ TEST_CASE("update_rt recomputes what moved: many calls, one joint at a time, equ
       REQUIRE(a.t.y == b.t.y);
       REQUIRE(a.t.z == b.t.z);
       for (int e = 0; e < 9; ++e) REQUIRE(a.r[e] == b.r[e]);
+      // The joint axes and origins, as the hand Jacobian reads them.
+      std::array<double, robot::kHandJoints> ga{}, gb{};
+      k.add_hand_jacobian_transpose(link, b.t, {1, 2, 3}, ga);
+      fresh.add_hand_jacobian_transpose(link, b.t, {1, 2, 3}, gb);
+      REQUIRE(ga == gb);
     }
   }
 }
